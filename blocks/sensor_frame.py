@@ -1,0 +1,190 @@
+"""The sensor-frame transformation (Rizun eq. 35) of any earth-frame LTI filter.
+
+An earth-frame filter ẋ = A·x + B·u, y = C·x + D·u (one scalar axis, n states) acts on
+each component of the accelerometer signal in the gyro-estimated earth frame. Carried
+into the sensor frame with d/dt|sensor = d/dt|earth − ω̂×, each of its n states becomes a
+3-vector (the rows of X, n×3) that also turns with −ω̂×:
+
+    dX/dt = A·X + B·y_aᵀ − (ω̂ × each row of X),      ĝ = C·X + D·y_aᵀ.
+
+Discrete time (sample time Ts): the rotation over a sample is applied exactly (constant
+ω̂ over (t[k−1], t[k]], NOTES §1), the LTI part by its zero-order-hold form (Ad, Bd).
+Rotation and LTI part act on different indices of X and so commute; the step is exact
+for an earth-frame-constant input. The same compiled step serves the python-control
+block, the batch path and the FMU.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import control
+import numpy as np
+from .jit import kernel
+
+from .quaternion import level_quat, quat_multiply, quat_normalized, quat_rotate, rotvec_quat
+
+AXES = ("x", "y", "z")
+GYRO_INPUTS = [f"gyr_{a}" for a in AXES]
+ACC_INPUTS = [f"acc_{a}" for a in AXES]
+GRAVITY_OUTPUTS = [f"ghat_{a}" for a in AXES]
+QUAT_NAMES = ["q_w", "q_x", "q_y", "q_z"]
+
+
+@dataclass(frozen=True)
+class DiscreteFilter:
+    """Zero-order-hold form of a SISO earth-frame filter at sample time Ts (s)."""
+
+    Ad: np.ndarray  # n×n
+    Bd: np.ndarray  # n
+    C: np.ndarray  # n
+    D: float
+    Ts: float
+
+    @classmethod
+    def from_lti(cls, earth_filter, Ts: float) -> "DiscreteFilter":
+        if not (math.isfinite(Ts) and Ts > 0):
+            raise ValueError(f"sample time Ts must be a finite positive number of seconds, got {Ts!r}")
+        ss = _siso_state_space(earth_filter)
+        disc = control.c2d(ss, Ts, method="zoh")
+        return cls(
+            Ad=np.ascontiguousarray(disc.A, dtype=float),
+            Bd=np.ascontiguousarray(np.ravel(disc.B), dtype=float),
+            C=np.ascontiguousarray(np.ravel(disc.C), dtype=float),
+            D=float(np.ravel(disc.D)[0]),
+            Ts=float(Ts),
+        )
+
+    @property
+    def order(self) -> int:
+        return self.Ad.shape[0]
+
+    def rest_state(self, acc0) -> np.ndarray:
+        """State X (n×3) the filter holds after resting with constant input acc0 (m/s²)."""
+        unit = np.linalg.solve(np.eye(self.order) - self.Ad, self.Bd)
+        return np.outer(unit, np.asarray(acc0, dtype=float))
+
+
+@kernel(inline=True)
+def sensor_frame_step(X, q, gyr, acc, k, Ad, Bd, C, D, Ts, Xr, g_out):
+    """Sample k: rotate the state rows by −ω̂·Ts, apply the ZOH filter, output ĝ.
+
+    X (n×3) and q (4, sensor → earth) are updated in place; g_out[k] receives ĝ (m/s²).
+    q integrates the gyro and is levelled each sample so that q rotates ĝ onto earth up
+    (its heading is integrated gyro). gyr[k] in rad/s is the mean rate over
+    (t[k−1], t[k]], acc[k] in m/s² is taken at t[k]. Xr (n×3) is scratch space.
+    """
+    n = X.shape[0]
+    dq = rotvec_quat(gyr[k, 0] * Ts, gyr[k, 1] * Ts, gyr[k, 2] * Ts)
+    # a vector fixed in the earth frame turns by the inverse rotation in sensor coordinates
+    dq_inv = (dq[0], -dq[1], -dq[2], -dq[3])
+    for j in range(n):
+        Xr[j, 0], Xr[j, 1], Xr[j, 2] = quat_rotate(dq_inv, (X[j, 0], X[j, 1], X[j, 2]))
+    a0, a1, a2 = acc[k, 0], acc[k, 1], acc[k, 2]
+    g0, g1, g2 = D * a0, D * a1, D * a2
+    for j in range(n):
+        s0, s1, s2 = Bd[j] * a0, Bd[j] * a1, Bd[j] * a2
+        for m in range(n):
+            s0 += Ad[j, m] * Xr[m, 0]
+            s1 += Ad[j, m] * Xr[m, 1]
+            s2 += Ad[j, m] * Xr[m, 2]
+        X[j, 0], X[j, 1], X[j, 2] = s0, s1, s2
+        g0 += C[j] * s0
+        g1 += C[j] * s1
+        g2 += C[j] * s2
+    g_out[k, 0], g_out[k, 1], g_out[k, 2] = g0, g1, g2
+    # orientation: integrate the gyro, then level it onto ĝ
+    qt = quat_multiply((q[0], q[1], q[2], q[3]), dq)
+    norm = math.sqrt(g0 * g0 + g1 * g1 + g2 * g2)
+    if norm > 0.0:
+        qt = quat_multiply(level_quat(quat_rotate(qt, (g0, g1, g2)), norm), qt)
+    q[0], q[1], q[2], q[3] = quat_normalized(qt)
+
+
+@kernel()
+def sensor_frame_run(gyr, acc, Ad, Bd, C, D, Ts, X, q, g_out, q_out):
+    """Run sensor_frame_step over N samples; X and q hold the final state afterwards."""
+    Xr = np.empty_like(X)
+    for k in range(gyr.shape[0]):
+        sensor_frame_step(X, q, gyr, acc, k, Ad, Bd, C, D, Ts, Xr, g_out)
+        q_out[k, 0], q_out[k, 1], q_out[k, 2], q_out[k, 3] = q[0], q[1], q[2], q[3]
+
+
+def state_names(order: int) -> list[str]:
+    """Names of the 3·n sensor-frame filter states, row by row of X."""
+    return [f"x{j}_{a}" for j in range(order) for a in AXES]
+
+
+def sensor_frame_system(earth_filter, dt: float | None = None, name: str = "estimator"):
+    """python-control nonlinear I/O system of an earth-frame SISO filter in the sensor frame.
+
+    Inputs gyr_x..z (rad/s) and acc_x..z (m/s²); outputs ghat_x..z (m/s²).
+    dt None: continuous time, states X (row by row). dt > 0: discrete time with the
+    compiled step above; states X then q_w..q_z, outputs also q_w..q_z. A discrete
+    system's output at k is taken after the update with the inputs at k, so it equals
+    the batch path's estimate at k; x0 should come from `initial_state`.
+    """
+    if dt is None:
+        return _continuous_system(_siso_state_space(earth_filter), name)
+    disc = DiscreteFilter.from_lti(earth_filter, dt)
+    n = disc.order
+
+    def advance(x, u):
+        X = np.array(x[: 3 * n], dtype=float).reshape(n, 3)
+        q = np.array(x[3 * n :], dtype=float)
+        g = np.empty((1, 3))
+        gyr = np.array(u[:3], dtype=float).reshape(1, 3)
+        acc = np.array(u[3:6], dtype=float).reshape(1, 3)
+        sensor_frame_step(
+            X, q, gyr, acc, 0, disc.Ad, disc.Bd, disc.C, disc.D, disc.Ts, np.empty((n, 3)), g
+        )
+        return X, q, g[0]
+
+    def update(t, x, u, params):
+        X, q, _ = advance(x, u)
+        return np.concatenate([X.ravel(), q])
+
+    def output(t, x, u, params):
+        _, q, g = advance(x, u)
+        return np.concatenate([g, q])
+
+    return control.nlsys(
+        update, output, inputs=GYRO_INPUTS + ACC_INPUTS, outputs=GRAVITY_OUTPUTS + QUAT_NAMES,
+        states=state_names(n) + QUAT_NAMES, dt=disc.Ts, name=name,
+    )
+
+
+def initial_state(earth_filter, Ts: float, acc0) -> np.ndarray:
+    """Initial state vector of the discrete system: at rest on acc0, q = identity."""
+    X = DiscreteFilter.from_lti(earth_filter, Ts).rest_state(acc0)
+    return np.concatenate([X.ravel(), [1.0, 0.0, 0.0, 0.0]])
+
+
+def _continuous_system(ss, name):
+    A = np.asarray(ss.A, dtype=float)
+    B = np.ravel(ss.B).astype(float)
+    C = np.ravel(ss.C).astype(float)
+    D = float(np.ravel(ss.D)[0])
+    n = A.shape[0]
+
+    def update(t, x, u, params):
+        X = np.reshape(x, (n, 3))
+        dX = A @ X + np.outer(B, u[3:6]) - np.cross(u[:3], X)
+        return dX.ravel()
+
+    def output(t, x, u, params):
+        return C @ np.reshape(x, (n, 3)) + D * np.asarray(u[3:6])
+
+    return control.nlsys(
+        update, output, inputs=GYRO_INPUTS + ACC_INPUTS, outputs=GRAVITY_OUTPUTS,
+        states=state_names(n), name=name,
+    )
+
+
+def _siso_state_space(earth_filter) -> control.StateSpace:
+    ss = control.ss(earth_filter)
+    if ss.ninputs != 1 or ss.noutputs != 1:
+        raise ValueError("the earth-frame filter must be single-input single-output (one axis)")
+    if not ss.isctime():
+        raise ValueError("the earth-frame filter must be a continuous-time system")
+    return ss

@@ -1,0 +1,1 @@
+"""Systems around the estimator blocks: motions, sensor model, diagrams, batch runs, CLI."""

@@ -1,0 +1,133 @@
+"""The `attitude` command line: estimate, table1, bench."""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+from blocks.methods import METHODS
+
+EXIT_BAD_INPUT = 2
+EXIT_CHECK_FAILED = 1
+TABLE1_TOLERANCE = 0.07  # simulated cells must lie within ±7 % of eq. 50
+
+
+def _param(text: str) -> tuple[str, float]:
+    name, sep, value = text.partition("=")
+    if not sep:
+        raise argparse.ArgumentTypeError(f"expected NAME=VALUE, got {text!r}")
+    try:
+        number = float(value)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{name}: {value!r} is not a number") from None
+    return name.strip(), number
+
+
+def _method_help() -> str:
+    lines = []
+    for m in METHODS.values():
+        lines.append(f"{m.name}: {m.summary}")
+        for p in m.params:
+            default = "derived" if p.default is None else f"{p.default:g}"
+            lines.append(f"    {p.name} [{p.unit}] (default {default}): {p.doc}")
+    return "\n".join(lines)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="attitude", description="IMU attitude estimators (Rizun's optimal Wiener filter and peers).",
+    )
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    est = sub.add_parser(
+        "estimate", help="estimate attitude over a recording",
+        formatter_class=argparse.RawDescriptionHelpFormatter, epilog="methods and parameters:\n" + _method_help(),
+    )
+    est.add_argument("input", help="CSV (t,gyr_x,gyr_y,gyr_z,acc_x,acc_y,acc_z[,mag_x,mag_y,mag_z]) or BROAD .mat")
+    est.add_argument("--out", required=True, help="output CSV: t,q_w,q_x,q_y,q_z,g_x,g_y,g_z")
+    est.add_argument("--method", default="wiener", choices=sorted(METHODS))
+    est.add_argument("--fs", type=float, help="sample rate in Hz (required when the CSV has no t column)")
+    est.add_argument("--param", type=_param, action="append", default=[], metavar="NAME=VALUE",
+                     help="method parameter in the unit listed below; repeatable")
+    est.add_argument("--gyr-unit", default="rad/s", choices=["rad/s", "deg/s"])
+    est.add_argument("--acc-unit", default="m/s2", choices=["m/s2", "g"])
+
+    t1 = sub.add_parser("table1", help="Rizun's Table 1: analytic (eq. 50) and simulated RMS attitude error")
+    t1.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    t1.add_argument("--duration", type=float, default=20000.0, help="simulated seconds per cell (default 20000)")
+    t1.add_argument("--fs", type=float, default=100.0, help="simulation sample rate, Hz (default 100)")
+    t1.add_argument("--seed", type=int, default=0)
+
+    bn = sub.add_parser("bench", help="samples per second of the batch estimator, vqf and ahrs Madgwick")
+    bn.add_argument("--json", action="store_true")
+    bn.add_argument("--samples", type=int, default=100_000)
+    bn.add_argument("--repeat", type=int, default=10, help="interleaved rounds; each method's best run counts (default 10)")
+    return parser
+
+
+def cmd_estimate(args) -> int:
+    from .batch import estimate
+    from .recording import read_recording, write_estimate
+
+    rec = read_recording(args.input, fs=args.fs, gyr_unit=args.gyr_unit, acc_unit=args.acc_unit)
+    result = estimate(rec.gyr, rec.acc, rec.fs, args.method, dict(args.param))
+    write_estimate(args.out, rec.t, result.quat, result.up)
+    print(f"attitude: {len(rec.gyr)} samples at {rec.fs:g} Hz, method {args.method} → {args.out}", file=sys.stderr)
+    return 0
+
+
+def cmd_table1(args) -> int:
+    from .experiments import table1
+
+    if not (args.duration > 0 and args.fs > 0):
+        raise ValueError("--duration and --fs must be positive")
+    rows = table1(duration=args.duration, fs=args.fs, seed=args.seed)
+    failed = [
+        (row, cell) for row in rows for cell in row["cells"]
+        if abs(cell["simulated_deg"] / cell["analytic_deg"] - 1) > TABLE1_TOLERANCE
+    ]
+    if args.json:
+        print(json.dumps(rows, indent=2))
+    else:
+        print("Rizun (2008) Table 1: RMS attitude error, analytic (eq. 50) | simulated, degrees "
+              f"(g = 9.8 m/s², {args.duration:g} s per cell at {args.fs:g} Hz)")
+        print(f"{'δn °/s/√Hz':>11} {'δv m/s/√Hz':>11} {'1/ω_g s':>8}  "
+              + "  ".join(f"{'a=' + format(c['a'], 'g'):>16}" for c in rows[0]["cells"]))
+        for row in rows:
+            cells = "  ".join(f"{c['analytic_deg']:7.3f} | {c['simulated_deg']:6.3f}" for c in row["cells"])
+            print(f"{row['delta_n_deg']:11.2f} {row['delta_v']:11.1f} {row['inv_omega_g_s']:8.2f}  {cells}")
+    if failed:
+        print(f"attitude: {len(failed)} simulated cells off eq. 50 by more than ±{TABLE1_TOLERANCE:.0%}",
+              file=sys.stderr)
+        return EXIT_CHECK_FAILED
+    return 0
+
+
+def cmd_bench(args) -> int:
+    from .bench import bench
+
+    if args.samples < 1000 or args.repeat < 1:
+        raise ValueError("--samples must be ≥ 1000 and --repeat ≥ 1")
+    result = bench(n=args.samples, repeat=args.repeat)
+    if args.json:
+        print(json.dumps(result, indent=2))
+    else:
+        print(f"{result['samples']} samples, best of up to {args.repeat} runs")
+        print(f"{'method':>10} {'samples/s':>14} {'vs vqf':>8}")
+        for name, rate in result["samples_per_s"].items():
+            print(f"{name:>10} {rate:14.4g} {result['ratio_vs_vqf'][name]:8.2f}")
+    return 0
+
+
+def main(argv=None) -> int:
+    args = build_parser().parse_args(argv)
+    handler = {"estimate": cmd_estimate, "table1": cmd_table1, "bench": cmd_bench}[args.command]
+    try:
+        return handler(args)
+    except (ValueError, OSError, RuntimeError) as exc:
+        print(f"attitude: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,133 @@
+"""The `attitude` command line: its contract (columns, JSON keys) and its errors."""
+import json
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from scipy.io import savemat
+
+from systems.batch import estimate
+from systems.cli import main
+from systems.motion import HumanMotion
+from systems.recording import OUTPUT_COLUMNS
+from systems.sensor_model import ImuModel
+
+FS = 100.0
+
+
+@pytest.fixture(scope="module")
+def imu():
+    motion = HumanMotion(delta_v=0.1, omega_c=5.0).generate(30.0, FS, seed=11)
+    return ImuModel(delta_n=math.radians(0.05)).apply(motion, seed=12)
+
+
+def _write_csv(path, columns: dict):
+    names = list(columns)
+    np.savetxt(path, np.column_stack([columns[n] for n in names]), delimiter=",",
+               header=",".join(names), comments="", fmt="%.17g")
+
+
+def _imu_columns(gyr, acc, with_t=True):
+    cols = {"t": np.arange(1, len(gyr) + 1) / FS} if with_t else {}
+    cols.update({f"gyr_{a}": gyr[:, i] for i, a in enumerate("xyz")})
+    cols.update({f"acc_{a}": acc[:, i] for i, a in enumerate("xyz")})
+    return cols
+
+
+def _read_output(path):
+    with open(path) as fh:
+        header = fh.readline().strip().split(",")
+    return header, np.loadtxt(path, delimiter=",", skiprows=1)
+
+
+def test_estimate_csv_writes_the_contracted_columns_equal_to_the_batch_path(tmp_path, imu):
+    gyr, acc = imu
+    _write_csv(tmp_path / "in.csv", _imu_columns(gyr, acc))
+    assert main(["estimate", str(tmp_path / "in.csv"), "--out", str(tmp_path / "out.csv"),
+                 "--param", "delta_n=0.001", "--param", "delta_v=1.5"]) == 0
+    header, data = _read_output(tmp_path / "out.csv")
+    assert header == list(OUTPUT_COLUMNS)
+    ref = estimate(gyr, acc, FS, "wiener", {"delta_n": 0.001, "delta_v": 1.5})
+    assert np.allclose(data[:, 0], np.arange(1, len(gyr) + 1) / FS)
+    assert np.abs(data[:, 1:5] - ref.quat).max() < 1e-9
+    assert np.abs(data[:, 5:8] - ref.up).max() < 1e-9
+    assert np.allclose(np.linalg.norm(data[:, 5:8], axis=1), 1.0)
+
+
+def test_estimate_without_t_column_needs_fs_and_honours_units(tmp_path, imu):
+    gyr, acc = imu
+    _write_csv(tmp_path / "in.csv", _imu_columns(np.degrees(gyr), acc / 9.81, with_t=False))
+    out = tmp_path / "out.csv"
+    assert main(["estimate", str(tmp_path / "in.csv"), "--out", str(out)]) == 2
+    assert main(["estimate", str(tmp_path / "in.csv"), "--out", str(out), "--fs", "100",
+                 "--gyr-unit", "deg/s", "--acc-unit", "g", "--method", "first_order"]) == 0
+    ref = estimate(gyr, acc, FS, "first_order")
+    assert np.abs(_read_output(out)[1][:, 1:5] - ref.quat).max() < 1e-8
+
+
+def test_estimate_reads_a_broad_mat_recording(tmp_path, imu):
+    gyr, acc = imu
+    savemat(tmp_path / "rec.mat", {"imu_gyr": gyr, "imu_acc": acc, "imu_mag": np.ones_like(gyr),
+                                   "sampling_rate": FS, "movement": np.ones(len(gyr))})
+    assert main(["estimate", str(tmp_path / "rec.mat"), "--out", str(tmp_path / "out.csv")]) == 0
+    assert np.abs(_read_output(tmp_path / "out.csv")[1][:, 1:5] - estimate(gyr, acc, FS).quat).max() < 1e-9
+
+
+def _bad_inputs(tmp_path, gyr, acc):
+    cols = _imu_columns(gyr, acc)
+    cases = {}
+    missing = dict(cols)
+    del missing["acc_z"]
+    cases["missing columns acc_z"] = (missing, [])
+    nan = {k: v.copy() for k, v in cols.items()}
+    nan["gyr_y"][7] = np.nan
+    cases["non-finite"] = (nan, [])
+    cases["deg/s"] = ({**cols, **{f"gyr_{a}": np.degrees(cols[f"gyr_{a}"]) * 10 for a in "xyz"}}, [])
+    cases["looks like g"] = ({**cols, **{f"acc_{a}": cols[f"acc_{a}"] / 9.81 for a in "xyz"}}, [])
+    jitter = dict(cols, t=cols["t"] * (1 + 0.2 * (np.arange(len(gyr)) % 2) / len(gyr)) + (np.arange(len(gyr)) % 3) * 0.004)
+    cases["not uniformly sampled"] = (jitter, [])
+    cases["unknown parameter"] = (cols, ["--param", "delta_q=1"])
+    cases["finite positive"] = (cols, ["--param", "delta_n=-1"])
+    cases["disagrees"] = (cols, ["--fs", "50"])
+    return cases
+
+
+def test_bad_input_ends_with_a_message_and_exit_2(tmp_path, imu, capsys):
+    for expected, (cols, extra) in _bad_inputs(tmp_path, *imu).items():
+        path = tmp_path / "bad.csv"
+        _write_csv(path, cols)
+        assert main(["estimate", str(path), "--out", str(tmp_path / "o.csv"), *extra]) == 2, expected
+        err = capsys.readouterr().err
+        assert "attitude: error:" in err and expected in err and "Traceback" not in err, (expected, err)
+    (tmp_path / "broken.mat").write_bytes(b"MATLAB 5.0 MAT-file, truncated")
+    for path in (tmp_path / "broken.mat", tmp_path / "absent.csv"):
+        assert main(["estimate", str(path), "--out", str(tmp_path / "o.csv")]) == 2
+        assert "attitude: error:" in capsys.readouterr().err
+
+
+def test_console_entry_point_reports_errors_without_traceback(tmp_path):
+    proc = subprocess.run([sys.executable, "-m", "systems.cli", "estimate", str(tmp_path / "none.csv"),
+                           "--out", str(tmp_path / "o.csv")], capture_output=True, text=True)
+    assert proc.returncode == 2
+    assert "no such file" in proc.stderr and "Traceback" not in proc.stderr
+
+
+def test_table1_json_every_cell_within_7_percent(capsys):
+    assert main(["table1", "--json"]) == 0
+    rows = json.loads(capsys.readouterr().out)
+    assert [(r["delta_n_deg"], r["delta_v"]) for r in rows] == [(0.1, 1.0), (0.1, 2.0), (0.2, 1.0), (0.2, 2.0)]
+    for row in rows:
+        assert set(row) == {"delta_n_deg", "delta_v", "inv_omega_g_s", "cells"}
+        assert [c["a"] for c in row["cells"]] == [1.0, 0.5, 2.0]
+        for cell in row["cells"]:
+            assert cell["simulated_deg"] == pytest.approx(cell["analytic_deg"], rel=0.07)
+
+
+def test_bench_json_reports_rates_and_ratios(capsys):
+    assert main(["bench", "--json", "--samples", "2000", "--repeat", "1"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert set(result["samples_per_s"]) == {"wiener", "vqf", "madgwick"}
+    assert result["ratio_vs_vqf"]["vqf"] == pytest.approx(1.0)
+    assert all(rate > 0 for rate in result["samples_per_s"].values())

@@ -1,0 +1,69 @@
+"""Motions, sensor model and the closed-loop diagram against exact truth."""
+import math
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from systems.batch import estimate
+from systems.diagram import simulate_closed_loop
+from systems.errors import inclination_error
+from systems.motion import HumanMotion, _human_run, incline_oscillation, steady_lever_arm
+from systems.sensor_model import ImuModel
+
+
+def test_human_motion_truth_is_exact_and_has_the_eq14_velocity_spectrum():
+    motion = HumanMotion(delta_v=1.5, omega_c=8.0).generate(4000.0, 100.0, seed=2)
+    rot = Rotation.from_quat(motion.quat, scalar_first=True)
+    # the gyro sample is the constant rate of its interval: re-integrating gives the truth
+    assert np.abs((rot[:-1].inv() * rot[1:]).as_rotvec() - motion.gyr[1:] / 100.0).max() < 1e-14
+    # earth-frame specific force minus gravity, integrated, is the velocity: variance δv²ω_c/4
+    velocity = np.cumsum(rot.apply(motion.acc) - [0, 0, 9.81], axis=0) / 100.0
+    assert np.var(velocity, axis=0) == pytest.approx(np.full(3, 1.5**2 * 8.0 / 4), rel=0.08)
+    assert motion.gyr.std(axis=0) == pytest.approx(np.ones(3), rel=0.1)
+
+
+def test_sensor_model_noise_density_and_offsets():
+    motion = HumanMotion().generate(1000.0, 200.0, seed=1)
+    dn = math.radians(0.1)
+    gyr, acc = ImuModel(delta_n=dn, gyr_offset=(0.01, -0.02, 0.03), acc_offset=(1, 1, 1)).apply(motion)
+    noise = gyr - motion.gyr
+    assert noise.mean(axis=0) == pytest.approx([0.01, -0.02, 0.03], abs=3 * dn * 10 / math.sqrt(len(noise)))
+    # one-sided density δn at 200 Hz: per-sample s.d. δn·√(fs/2)
+    assert noise.std(axis=0) == pytest.approx(np.full(3, dn * math.sqrt(100.0)), rel=0.01)
+    assert np.allclose(acc - motion.acc, 1.0)
+    with pytest.raises(ValueError):
+        ImuModel(delta_n=-1.0)
+
+
+def test_steady_lever_arm_closed_form():
+    m = steady_lever_arm(2.0, 0.2, duration=10.0, fs=100.0, g=9.81)
+    rot = Rotation.from_quat(m.quat, scalar_first=True)
+    assert np.abs((rot[:-1].inv() * rot[1:]).as_rotvec() - m.gyr[1:] / 100.0).max() < 1e-12
+    # specific force in sensor coordinates is constant: gravity plus 0.8 m/s² towards the axis
+    assert np.ptp(m.acc, axis=0).max() < 1e-12
+    assert np.linalg.norm(rot.apply(m.acc)[0] - [0, 0, 9.81]) == pytest.approx(0.8, rel=1e-12)
+
+
+def test_incline_motion_has_zero_mean_acceleration_and_the_stated_peak():
+    m = incline_oscillation(duration=10.0, fs=1000.0, g=9.81)
+    earth = Rotation.from_quat(m.quat, scalar_first=True).apply(m.acc) - [0, 0, 9.81]
+    assert np.abs(earth.mean(axis=0)).max() < 1e-9
+    assert np.linalg.norm(earth, axis=1).max() == pytest.approx(math.sqrt(2) * 9.81, rel=1e-4)
+    assert np.allclose(earth[:, 1], 0) and np.allclose(earth[:, 0], earth[:, 2])  # along the 45° slope
+
+
+def test_closed_loop_diagram_equals_the_batch_pipeline():
+    motion = HumanMotion()
+    imu = ImuModel(delta_n=math.radians(0.1), gyr_offset=(0.01, 0.0, -0.01))
+    fs = 100.0
+    noise, resp = simulate_closed_loop(motion, imu, fs, duration=5.0, seed=3)
+    state = motion.initial_state()
+    truth = np.empty((len(noise), 10))
+    _human_run(state, np.ascontiguousarray(noise[:, :6]), motion.coefficients(fs), truth)
+    gyr, acc = imu.measure(truth[:, 0:3], truth[:, 3:6], noise[:, 6:9], fs)
+    est = estimate(gyr, acc, fs, initial_gravity=[0, 0, motion.g])
+    up = Rotation.from_quat(truth[:, 6:10], scalar_first=True).inv().apply([0, 0, 1])
+    assert np.abs(resp.outputs[1:4].T - est.gravity).max() <= 1e-12
+    assert np.abs(resp.outputs[4:8].T - est.quat).max() <= 1e-12
+    assert np.abs(resp.outputs[0] - inclination_error(est.gravity, up)).max() <= 1e-12

@@ -1,0 +1,131 @@
+"""The sensor-frame estimator blocks: linearisation, exactness, and one step behind
+the continuous block, the discrete block, the batch path and the plain-Python source."""
+import json
+import math
+import os
+import subprocess
+import sys
+
+import control
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from blocks import earth_filters as ef
+from blocks.methods import method
+from blocks.sensor_frame import initial_state, sensor_frame_system
+from systems.batch import estimate
+from systems.errors import inclination_error
+from systems.motion import HumanMotion
+
+FILTERS = {
+    "eq34": ef.butterworth(0.13),
+    "eq33": ef.wiener_band_limited(0.13, 0.5),
+    "first_order": ef.first_order(0.05),
+}
+
+
+@pytest.mark.parametrize("name", FILTERS)
+def test_linearising_the_continuous_estimator_at_rest_gives_the_earth_filter_per_axis(name):
+    filt = FILTERS[name]
+    sys_c = sensor_frame_system(filt)
+    lin = control.linearize(sys_c, np.zeros(sys_c.nstates), np.zeros(6))
+    for w in np.logspace(-3, 2, 11):
+        resp = np.asarray(lin(1j * w))  # 3 outputs × 6 inputs
+        expected = complex(filt(1j * w))
+        for axis in range(3):
+            assert abs(resp[axis, 3 + axis] - expected) < 1e-9
+        off = resp.copy()
+        off[[0, 1, 2], [3, 4, 5]] = 0
+        assert np.abs(off).max() < 1e-9
+
+
+def _random_imu(n=400, seed=3):
+    rng = np.random.default_rng(seed)
+    gyr = rng.normal(0, 2.0, (n, 3))
+    gyr[::50] *= 20  # a few fast samples beyond the small-angle series
+    return gyr, rng.normal(0, 3.0, (n, 3)) + [0, 0, 9.81]
+
+
+@pytest.mark.parametrize("name", ["wiener", "first_order"])
+def test_discrete_block_and_batch_path_are_equal(name):
+    fs = 100.0
+    gyr, acc = _random_imu()
+    filt = method(name).filter()
+    block = sensor_frame_system(filt, dt=1 / fs)
+    t = np.arange(len(gyr)) / fs
+    resp = control.input_output_response(block, t, np.hstack([gyr, acc]).T, X0=initial_state(filt, 1 / fs, acc[0]))
+    batch = estimate(gyr, acc, fs, name)
+    assert np.abs(resp.outputs[:3].T - batch.gravity).max() <= 1e-12
+    assert np.abs(resp.outputs[3:].T - batch.quat).max() <= 1e-12
+
+
+def test_compiled_kernel_equals_its_plain_python_source():
+    """The batch path run with numba's JIT disabled (the readable reference) gives the same numbers."""
+    code = (
+        "import json, numpy as np; from systems.batch import estimate;"
+        "from tests.test_sensor_frame import _random_imu;"
+        "g, a = _random_imu(); e = estimate(g, a, 100.0);"
+        "print(json.dumps([e.gravity.tolist(), e.quat.tolist()]))"
+    )
+    env = dict(os.environ, NUMBA_DISABLE_JIT="1")
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    out = subprocess.run([sys.executable, "-c", code], env=env, cwd=root, capture_output=True, text=True, check=True)
+    gravity, quat = (np.array(x) for x in json.loads(out.stdout))
+    compiled = estimate(*_random_imu(), 100.0)
+    assert np.abs(gravity - compiled.gravity).max() <= 1e-12
+    assert np.abs(quat - compiled.quat).max() <= 1e-12
+
+
+def test_pure_rotation_without_acceleration_is_tracked_exactly():
+    """For an earth-fixed input and piecewise-constant rate the discrete step is exact (NOTES §2)."""
+    motion = HumanMotion(delta_v=1e-12, rot_rms=3.0, rot_cutoff=5.0).generate(120.0, 100.0, seed=4)
+    # the motion starts level before its first sample: start the filter on the true gravity
+    est = estimate(motion.gyr, motion.acc, 100.0, initial_gravity=[0.0, 0.0, 9.81])
+    assert np.abs(est.gravity - 9.81 * motion.up).max() < 1e-9
+    # the quaternion output carries the same inclination, and heading from the gyro alone
+    assert inclination_error(Rotation.from_quat(est.quat, scalar_first=True).apply(est.up),
+                             np.tile([0, 0, 1.0], (len(est.up), 1))).max() < 1e-9
+    q_err = Rotation.from_quat(est.quat, scalar_first=True) * Rotation.from_quat(motion.quat, scalar_first=True).inv()
+    assert q_err.magnitude().max() < 1e-9
+
+
+def _discrete_vs_continuous(fs, duration=20.0):
+    t = np.arange(int(duration * fs) + 1) / fs
+    rate = np.array([0.4, -0.3, 0.8])
+    orient = Rotation.from_rotvec(np.outer(t, rate))  # constant body rate
+    acc_earth = np.column_stack([np.sin(0.7 * t), np.cos(1.3 * t), 0.5 * np.sin(0.4 * t)])
+    acc = orient.inv().apply(acc_earth + [0, 0, 9.81])
+    gyr = np.tile(rate, (len(t), 1))
+    filt = ef.butterworth(0.5)
+    cont = control.input_output_response(
+        sensor_frame_system(filt), t, np.hstack([gyr, acc]).T, X0=initial_state(filt, 1 / fs, acc[0])[:6],
+        solve_ivp_kwargs={"rtol": 1e-10, "atol": 1e-12, "max_step": 1 / fs},
+    )
+    # discrete sample k covers (t[k-1], t[k]]: start it on the continuous run's state at t[0]
+    disc = estimate(gyr[1:], acc[1:], fs, params={"omega_g": 0.5}, initial_gravity=acc[0])
+    return np.abs(cont.outputs.T[1:] - disc.gravity).max()
+
+
+def test_discrete_step_converges_to_the_continuous_block_at_first_order():
+    """Smooth rotation and acceleration: the continuous system (RK45, independent of the
+    step) and the discrete step agree, with the O(Ts) error of holding acc[k] over a sample."""
+    coarse, fine = _discrete_vs_continuous(100.0), _discrete_vs_continuous(200.0)
+    assert fine < 1.2e-3
+    assert coarse / fine == pytest.approx(2.0, rel=0.1)
+
+
+def test_bad_input_is_refused_with_a_clear_message():
+    gyr, acc = _random_imu(10)
+    with pytest.raises(ValueError, match="shape"):
+        estimate(gyr[:, :2], acc, 100.0)
+    with pytest.raises(ValueError, match="differ in length"):
+        estimate(gyr, acc[:5], 100.0)
+    bad = acc.copy()
+    bad[4, 1] = np.nan
+    with pytest.raises(ValueError, match="non-finite.*sample 4"):
+        estimate(gyr, bad, 100.0)
+    with pytest.raises(ValueError, match="sample rate"):
+        estimate(gyr, acc, -5.0)
+    with pytest.raises(ValueError, match="sample time"):
+        sensor_frame_system(ef.butterworth(0.1), dt=math.inf)
