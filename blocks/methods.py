@@ -7,11 +7,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Callable, Mapping
 
 import control
 
 from . import earth_filters as ef
+from .sensor_frame import DiscreteFilter
 
 
 @dataclass(frozen=True)
@@ -100,3 +102,9 @@ def method(name: str) -> Method:
         return METHODS[name]
     except KeyError:
         raise ValueError(f"unknown method {name!r}; available: {', '.join(METHODS)}") from None
+
+
+@lru_cache(maxsize=64)
+def discrete_filter(name: str, params: tuple, Ts: float) -> DiscreteFilter:
+    """Method name's filter for params ((name, value) pairs) at sample time Ts (s), designed once."""
+    return DiscreteFilter.from_lti(method(name).filter(dict(params)), Ts)

@@ -76,3 +76,13 @@ def level_quat(u, norm):
     else:
         w = horizontal2 / (norm - u[2])  # = norm + u[2], without cancellation
     return w, u[1], -u[0], 0.0
+
+
+@kernel(inline=True)
+def quat_euler_zyx(q):
+    """Roll, pitch, yaw (rad) of the Z-Y-X (yaw, then pitch, then roll) sequence of unit q."""
+    w, x, y, z = q
+    roll = math.atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
+    pitch = math.asin(min(1.0, max(-1.0, 2.0 * (w * y - z * x))))
+    yaw = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+    return roll, pitch, yaw

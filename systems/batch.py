@@ -3,13 +3,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from functools import lru_cache
 from typing import Mapping
 
 import numpy as np
 
-from blocks.methods import method as get_method
-from blocks.sensor_frame import DiscreteFilter, sensor_frame_run
+from blocks.methods import discrete_filter
+from blocks.sensor_frame import sensor_frame_run
 
 
 @dataclass
@@ -46,12 +45,6 @@ def check_imu(gyr, acc, fs: float) -> tuple[np.ndarray, np.ndarray]:
     if arrays[0].shape != arrays[1].shape:
         raise ValueError(f"gyr and acc differ in length: {arrays[0].shape[0]} vs {arrays[1].shape[0]}")
     return arrays[0], arrays[1]
-
-
-@lru_cache(maxsize=64)
-def discrete_filter(method: str, params: tuple, Ts: float) -> DiscreteFilter:
-    """The method's filter for params ((name, value) pairs) at sample time Ts (s), designed once."""
-    return DiscreteFilter.from_lti(get_method(method).filter(dict(params)), Ts)
 
 
 def estimate(

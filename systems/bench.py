@@ -63,3 +63,53 @@ def bench(n: int = 100_000, repeat: int = 5, budget_s: float = 3.0, progress: bo
         "samples_per_s": rates,
         "ratio_vs_vqf": {name: rate / rates["vqf"] for name, rate in rates.items()},
     }
+
+
+def bench_fmu(steps: int = 5000, repeat: int = 5, progress: bool = True) -> dict:
+    """Per-step cost (µs) of AttitudeEstimator.fmu and of a no-op FMU with its interface,
+    both driven by fmpy (set inputs, doStep, get outputs) in interleaved rounds."""
+    import tempfile
+
+    from fmpy import extract, read_model_description
+    from fmpy.fmi2 import FMU2Slave
+
+    from .fmu_build import build
+
+    gyr, acc = bench_recording(steps)
+    inputs = np.hstack([gyr, acc])
+    with tempfile.TemporaryDirectory(prefix="attitude_bench_") as tmp:
+        if progress:
+            print("bench: building AttitudeEstimator.fmu and NoOpEstimator.fmu", file=sys.stderr, flush=True)
+        paths = build(tmp, ("AttitudeEstimator", "NoOpEstimator"))
+        fmus = {}
+        for path in paths:
+            md = read_model_description(path)
+            vr = {v.name: v.valueReference for v in md.modelVariables}
+            fmu = FMU2Slave(guid=md.guid, unzipDirectory=extract(path), instanceName=path.stem,
+                            modelIdentifier=md.coSimulation.modelIdentifier)
+            fmu.instantiate()  # once: pythonfmu cannot instantiate again after fmi2FreeInstance
+            fmus[path.stem] = (fmu, [vr[f"{s}_{a}"] for s in ("gyr", "acc") for a in "xyz"],
+                               [vr[n] for n in ("q_w", "q_x", "q_y", "q_z", "g_x", "g_y", "g_z", "roll", "pitch", "yaw")],
+                               [vr["valid"]])
+        best = dict.fromkeys(fmus, np.inf)
+        for round_ in range(repeat):
+            for name, (fmu, vin, vout, vvalid) in fmus.items():
+                if progress:
+                    print(f"bench: round {round_ + 1}/{repeat}, {name}, {steps} steps", file=sys.stderr, flush=True)
+                fmu.reset()
+                fmu.setupExperiment(startTime=0.0)
+                fmu.enterInitializationMode()
+                fmu.exitInitializationMode()
+                start = time.perf_counter()
+                for k in range(steps):
+                    fmu.setReal(vin, inputs[k].tolist())
+                    fmu.doStep(currentCommunicationPoint=k / BENCH_FS, communicationStepSize=1.0 / BENCH_FS)
+                    fmu.getReal(vout)
+                    fmu.getBoolean(vvalid)
+                best[name] = min(best[name], (time.perf_counter() - start) / steps)
+                fmu.terminate()
+        for fmu, *_ in fmus.values():
+            fmu.freeInstance()
+    per_step = {name: t * 1e6 for name, t in best.items()}
+    return {"steps": steps, "us_per_step": per_step,
+            "ratio_vs_noop": per_step["AttitudeEstimator"] / per_step["NoOpEstimator"]}

@@ -1,4 +1,4 @@
-"""The `attitude` command line: estimate, table1, bench."""
+"""The `attitude` command line: estimate, table1, verify, bench."""
 from __future__ import annotations
 
 import argparse
@@ -58,9 +58,18 @@ def build_parser() -> argparse.ArgumentParser:
     t1.add_argument("--fs", type=float, default=100.0, help="simulation sample rate, Hz (default 100)")
     t1.add_argument("--seed", type=int, default=0)
 
+    vf = sub.add_parser("verify", help="co-simulate every profile with every estimator as FMUs; exit 1 if a bound is missed")
+    vf.add_argument("--json", action="store_true")
+    vf.add_argument("--fmu-dir", default="dist", help="where the FMUs are, built there if missing (default dist/)")
+    vf.add_argument("--rebuild", action="store_true", help="build the FMUs even if present")
+    vf.add_argument("--profile", action="append", help="only this profile (repeatable)")
+    vf.add_argument("--method", action="append", help="only this method (repeatable)")
+
     bn = sub.add_parser("bench", help="samples per second of the batch estimator, vqf and ahrs Madgwick")
     bn.add_argument("--json", action="store_true")
     bn.add_argument("--samples", type=int, default=100_000)
+    bn.add_argument("--fmu", action="store_true",
+                    help="per-step cost of AttitudeEstimator.fmu against a no-op FMU of the same interface")
     bn.add_argument("--repeat", type=int, default=10, help="interleaved rounds; each method's best run counts (default 10)")
     return parser
 
@@ -103,11 +112,51 @@ def cmd_table1(args) -> int:
     return 0
 
 
+def cmd_verify(args) -> int:
+    from .fmu_build import ensure_built
+    from .motion import PROFILES
+    from .verify import SCENARIOS, verify
+
+    for name in args.profile or []:
+        if name not in SCENARIOS:
+            raise ValueError(f"unknown profile {name!r}; verified profiles: {', '.join(SCENARIOS)}")
+    for name in args.method or []:
+        if name not in METHODS:
+            raise ValueError(f"unknown method {name!r}; available: {', '.join(METHODS)}")
+    fmu_dir = ensure_built(args.fmu_dir, args.rebuild, log=lambda m: print(f"attitude: {m}", file=sys.stderr))
+    rows = verify(fmu_dir, args.profile, args.method)
+    if args.json:
+        print(json.dumps({"rows": rows}, indent=2))
+    else:
+        print(f"{'profile':>10} {'method':>12} {'rms °':>8} {'max °':>8} {'mean °':>9}  {'bound °':>8} {'on':>4}  result")
+        for r in rows:
+            print(f"{r['profile']:>10} {r['method']:>12} {r['rms_deg']:8.3f} {r['max_deg']:8.3f} {r['mean_deg']:9.5f}"
+                  f"  {r['bound_deg']:8.3f} {r['metric']:>4}  {'pass' if r['pass'] else 'FAIL'}")
+        print("profiles: " + "; ".join(f"{n}: {PROFILES[n].summary}" for n in dict.fromkeys(r["profile"] for r in rows)))
+    failed = [r for r in rows if not r["pass"]]
+    if failed:
+        print(f"attitude: {len(failed)} of {len(rows)} rows missed their bound", file=sys.stderr)
+        return EXIT_CHECK_FAILED
+    return 0
+
+
 def cmd_bench(args) -> int:
     from .bench import bench
 
     if args.samples < 1000 or args.repeat < 1:
         raise ValueError("--samples must be ≥ 1000 and --repeat ≥ 1")
+    if args.fmu:
+        from .bench import bench_fmu
+
+        result = bench_fmu(steps=min(args.samples, 5000), repeat=args.repeat)
+        if args.json:
+            print(json.dumps(result, indent=2))
+        else:
+            print(f"{result['steps']} steps under fmpy, best of {args.repeat} interleaved rounds")
+            for name, us in result["us_per_step"].items():
+                print(f"{name:>18} {us:8.1f} µs/step")
+            print(f"{'ratio':>18} {result['ratio_vs_noop']:8.2f}")
+        return 0
     result = bench(n=args.samples, repeat=args.repeat)
     if args.json:
         print(json.dumps(result, indent=2))
@@ -121,7 +170,7 @@ def cmd_bench(args) -> int:
 
 def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
-    handler = {"estimate": cmd_estimate, "table1": cmd_table1, "bench": cmd_bench}[args.command]
+    handler = {"estimate": cmd_estimate, "table1": cmd_table1, "verify": cmd_verify, "bench": cmd_bench}[args.command]
     try:
         return handler(args)
     except (ValueError, OSError, RuntimeError) as exc:

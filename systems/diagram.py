@@ -12,7 +12,7 @@ from .errors import inclination_error
 from .motion import AXES, HumanMotion
 from .sensor_model import ImuModel
 
-NOISE_INPUTS = [f"eps_{s}_{a}" for s in "vw" for a in AXES] + [f"n_{a}" for a in AXES]
+NOISE_INPUTS = [f"eps_{s}_{a}" for s in "vw" for a in AXES] + [f"{s}_{a}" for s in ("n", "na") for a in AXES]
 
 
 def attitude_error_system(fs: float, name: str = "error"):

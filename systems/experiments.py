@@ -139,7 +139,7 @@ def lever_arm_bias(rate: float = 2.0, radius: float = 0.2, duration: float = 600
 
     Both use the same Butterworth (eq. 34); ideal sensors. Angles in degrees.
     """
-    motion = steady_lever_arm(rate, radius, duration=duration, fs=fs, g=g)
+    motion = steady_lever_arm(rate, radius, g=g).generate(duration, fs)
     params = {"delta_n": delta_n, "delta_v": delta_v, "g": g}
     filt = get_method("wiener").filter(params)
     start = int(settle_time(filt) * fs)
@@ -165,7 +165,7 @@ def incline_angle_bias(duration: float = 600.0, fs: float = 100.0, frequency: fl
     Pitch is the angle of the sensor x axis above the horizontal, from the measured (or
     estimated) up-vector u as atan2(u_x, √(u_y² + u_z²)); degrees.
     """
-    motion = incline_oscillation(frequency=frequency, duration=duration, fs=fs, g=g)
+    motion = incline_oscillation(frequency=frequency, g=g).generate(duration, fs)
     params = {"delta_n": delta_n, "delta_v": delta_v, "g": g}
     filt = get_method("wiener").filter(params)
     start = int(settle_time(filt) * fs)

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Callable
 
 import control
 import numpy as np
@@ -18,6 +19,7 @@ from blocks.jit import kernel
 from blocks.quaternion import quat_multiply, quat_normalized, quat_rotate, rotvec_quat
 
 AXES = ("x", "y", "z")
+EARTH_FIELD_UT = (0.0, 20.0, -45.0)  # magnetic field in ENU, µT: northwards and down
 TRUTH_OUTPUTS = [f"omega_{a}" for a in AXES] + [f"f_{a}" for a in AXES] + [
     "qt_w", "qt_x", "qt_y", "qt_z"
 ]
@@ -40,6 +42,11 @@ class Motion:
     def up(self) -> np.ndarray:
         """N×3 true unit up-vector in sensor coordinates."""
         return Rotation.from_quat(self.quat, scalar_first=True).inv().apply([0.0, 0.0, 1.0])
+
+    @property
+    def mag(self) -> np.ndarray:
+        """N×3 ideal magnetic field in sensor coordinates, µT (EARTH_FIELD_UT in the earth frame)."""
+        return Rotation.from_quat(self.quat, scalar_first=True).inv().apply(EARTH_FIELD_UT)
 
 
 @dataclass(frozen=True)
@@ -114,6 +121,10 @@ class HumanMotion:
         """At rest, level: v = 0, ω = 0, q = identity."""
         return np.array([0, 0, 0, 0, 0, 0, 1.0, 0, 0, 0])
 
+    def stream(self, seed: int = 0) -> "HumanStream":
+        """Sample-by-sample generator equal to generate() with the same seed."""
+        return HumanStream(self, seed)
+
 
 @kernel(inline=True)
 def _human_step(state, noise, k, c, out):
@@ -140,35 +151,143 @@ def _human_run(state, noise, coef, out):
         _human_step(state, noise, k, coef, out)
 
 
-def steady_lever_arm(rate: float, radius: float, mount_deg=(20.0, -10.0), duration=600.0, fs=100.0,
-                     g: float = STANDARD_GRAVITY) -> Motion:
+class HumanStream:
+    """HumanMotion sample by sample (for the motion FMU): the same compiled step and the
+    same noise stream as HumanMotion.generate with the same seed."""
+
+    def __init__(self, motion: HumanMotion, seed: int = 0):
+        self.motion = motion
+        self.rng = np.random.default_rng(seed)
+        self.state = motion.initial_state()
+        self._out = np.empty((1, 10))
+        self._h = None
+
+    def step(self, t: float, h: float):
+        """Ideal (gyr, specific force, quat) for the interval (t − h, t]."""
+        if h != self._h:
+            self._coef, self._h = self.motion.coefficients(1.0 / h), h
+        _human_run(self.state, self.rng.standard_normal((1, 6)), self._coef, self._out)
+        return self._out[0, 0:3], self._out[0, 3:6], self._out[0, 6:10]
+
+
+@dataclass(frozen=True)
+class ClosedFormMotion:
+    """A motion given by closed forms of orientation R(t) (sensor → earth) and earth-frame
+    velocity v(t) (m/s). Sampled over (t − h, t]: gyr is the rotation vector of
+    R(t−h)ᵀR(t) over h (so integrating it reproduces R exactly) and the specific force is
+    R(t)ᵀ·((v(t) − v(t−h))/h + g·ẑ)."""
+
+    name: str
+    orientation: Callable[[np.ndarray], Rotation]
+    velocity: Callable[[np.ndarray], np.ndarray]
+    g: float = STANDARD_GRAVITY
+
+    def at(self, t, h: float):
+        """(gyr N×3, specific force N×3, quat N×4) for the intervals ending at times t."""
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        now, before = self.orientation(t), self.orientation(t - h)
+        gyr = (before.inv() * now).as_rotvec() / h
+        acc = (self.velocity(t) - self.velocity(t - h)) / h + [0.0, 0.0, self.g]
+        return gyr, now.inv().apply(acc), now.as_quat(scalar_first=True)
+
+    def generate(self, duration: float, fs: float, seed: int = 0) -> Motion:
+        """Sample duration (s) at fs (Hz); seed is unused (the motion is deterministic)."""
+        t = np.arange(1, int(round(duration * fs)) + 1) / fs
+        gyr, acc, quat = self.at(t, 1.0 / fs)
+        return Motion(fs, quat, gyr, acc)
+
+    def stream(self, seed: int = 0) -> "ClosedFormMotion":
+        """Sample by sample: step(t, h) gives the interval (t − h, t], as generate() does."""
+        return self
+
+    def step(self, t: float, h: float):
+        gyr, acc, quat = self.at(t, h)
+        return gyr[0], acc[0], quat[0]
+
+
+def steady_lever_arm(rate: float = 2.0, radius: float = 0.2, mount_deg=(20.0, -10.0),
+                     g: float = STANDARD_GRAVITY) -> ClosedFormMotion:
     """Rizun §2.4: sensor turning at rate (rad/s) about the vertical on an arm of radius (m).
 
-    The sensor is mounted with roll and pitch mount_deg (degrees) relative to the arm,
-    so its mean centripetal acceleration in sensor coordinates, −rate²·radius along the
-    arm, is constant and non-zero. Closed form: R(t) = Rz(rate·t)·R_mount.
+    The sensor is mounted with roll and pitch mount_deg (degrees) relative to the arm, so
+    its mean centripetal acceleration in sensor coordinates, rate²·radius towards the
+    axis, is constant and non-zero. R(t) = Rz(rate·t)·R_mount.
     """
-    t = np.arange(1, int(round(duration * fs)) + 1) / fs
     mount = Rotation.from_euler("xy", mount_deg, degrees=True)
-    orient = Rotation.from_rotvec(np.outer(rate * t, [0.0, 0.0, 1.0])) * mount
-    position = radius * np.column_stack([np.cos(rate * t), np.sin(rate * t), np.zeros_like(t)])
-    specific_force = -rate**2 * position + [0.0, 0.0, g]
-    gyr = np.tile(mount.inv().apply([0.0, 0.0, rate]), (len(t), 1))
-    return Motion(fs, orient.as_quat(scalar_first=True), gyr, orient.inv().apply(specific_force))
+    return ClosedFormMotion(
+        "lever_arm",
+        lambda t: Rotation.from_rotvec(np.outer(rate * t, [0.0, 0.0, 1.0])) * mount,
+        lambda t: rate * radius * np.column_stack([-np.sin(rate * t), np.cos(rate * t), np.zeros_like(t)]),
+        g,
+    )
 
 
-def incline_oscillation(incline_deg=45.0, peak_acc_g=math.sqrt(2.0), frequency=1.0, duration=600.0,
-                        fs=100.0, g: float = STANDARD_GRAVITY) -> Motion:
-    """Rizun §2.5: harmonic motion along an incline, sensor x along the incline, no rotation.
+def incline_oscillation(incline_deg: float = 45.0, peak_acc_g: float = math.sqrt(2.0), frequency: float = 1.0,
+                        g: float = STANDARD_GRAVITY) -> ClosedFormMotion:
+    """Rizun §2.5 (Fig. 3): harmonic motion along an incline, sensor x up the slope, no rotation.
 
-    Acceleration peak_acc_g·g·sin(2π·frequency·t) along the incline (Fig. 3).
+    Acceleration peak_acc_g·g·sin(2π·frequency·t) along the incline.
     """
-    t = np.arange(1, int(round(duration * fs)) + 1) / fs
     orient = Rotation.from_euler("y", -incline_deg, degrees=True)  # sensor x up the slope
     along = orient.apply([1.0, 0.0, 0.0])
     w = 2 * math.pi * frequency
-    # mean acceleration over each sample interval, as for every motion here
-    mean_acc = peak_acc_g * g * (np.cos(w * (t - 1 / fs)) - np.cos(w * t)) * fs / w
-    specific_force = np.outer(mean_acc, along) + [0.0, 0.0, g]
-    quat = np.tile(orient.as_quat(scalar_first=True), (len(t), 1))
-    return Motion(fs, quat, np.zeros((len(t), 3)), orient.inv().apply(specific_force))
+    amplitude = peak_acc_g * g / w  # of the velocity, m/s
+    return ClosedFormMotion(
+        "incline",
+        lambda t: Rotation.from_quat(np.tile(orient.as_quat(), (len(t), 1))),
+        lambda t: np.outer(-amplitude * np.cos(w * t), along),
+        g,
+    )
+
+
+@dataclass(frozen=True)
+class Profile:
+    """A named motion with documented parameters (blocks.methods.Param)."""
+
+    name: str
+    summary: str
+    factory: Callable
+    params: tuple
+
+    def motion(self, overrides: dict | None = None, g: float = STANDARD_GRAVITY):
+        """The motion for these parameter overrides (unknown names are refused)."""
+        known = {p.name: p.default for p in self.params}
+        for name, value in (overrides or {}).items():
+            if name not in known:
+                raise ValueError(f"unknown parameter {name!r} for profile {self.name!r}; known: {', '.join(known)}")
+            if not math.isfinite(value):
+                raise ValueError(f"parameter {name} must be finite, got {value!r}")
+            known[name] = float(value)
+        return self.factory(**known, g=g)
+
+
+def _profiles() -> dict:
+    from blocks.methods import Param
+
+    return {p.name: p for p in (
+        Profile("human", "band-limited human motion (Rizun eq. 14) with random rotation", HumanMotion, (
+            Param("delta_v", 1.0, "m/s/√Hz", "slosh: density of the velocity"),
+            Param("omega_c", 10.0, "rad/s", "band limit of the velocity"),
+            Param("rot_rms", 1.0, "rad/s", "RMS angular rate per axis"),
+            Param("rot_cutoff", 5.0, "rad/s", "band limit of the angular rate"),
+        )),
+        Profile("lever_arm", "steady rotation about the vertical on a lever arm (Rizun §2.4)", steady_lever_arm, (
+            Param("rate", 2.0, "rad/s", "turn rate"),
+            Param("radius", 0.2, "m", "arm length"),
+        )),
+        Profile("incline", "harmonic motion along a 45° incline, peak √2·g (Rizun §2.5)", incline_oscillation, (
+            Param("incline_deg", 45.0, "deg", "slope of the incline"),
+            Param("peak_acc_g", math.sqrt(2.0), "1", "peak acceleration in units of g"),
+            Param("frequency", 1.0, "Hz", "frequency of the oscillation"),
+        )),
+    )}
+
+
+PROFILES = _profiles()
+
+
+def profile(name: str) -> Profile:
+    try:
+        return PROFILES[name]
+    except KeyError:
+        raise ValueError(f"unknown profile {name!r}; available: {', '.join(PROFILES)}") from None

@@ -12,44 +12,52 @@ from .motion import AXES, Motion
 
 @dataclass(frozen=True)
 class ImuModel:
-    """Gyro y_g = ω + n + b, accelerometer y_a = f + acc_offset.
+    """Gyro y_g = ω + n + b, accelerometer y_a = f + n_a + acc_offset, magnetometer ideal.
 
     delta_n: gyro white-noise density, rad/s/√Hz (one-sided; per-sample s.d.
-    delta_n·√(fs/2)); gyr_offset: constant gyro offset b, rad/s (3);
-    acc_offset: constant accelerometer offset, m/s² (3).
+    delta_n·√(fs/2)); gyr_offset: constant gyro offset b, rad/s (3); acc_noise:
+    accelerometer white-noise density, m/s²/√Hz; acc_offset: constant accelerometer
+    offset, m/s² (3). Noise enters as unit-normal samples, 6 per sample (gyro, acc).
     """
 
     delta_n: float = 0.0
     gyr_offset: tuple = (0.0, 0.0, 0.0)
+    acc_noise: float = 0.0
     acc_offset: tuple = (0.0, 0.0, 0.0)
 
     def __post_init__(self):
-        if not (math.isfinite(self.delta_n) and self.delta_n >= 0):
-            raise ValueError(f"delta_n must be finite and non-negative, got {self.delta_n!r}")
+        for name in ("delta_n", "acc_noise"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value >= 0):
+                raise ValueError(f"{name} must be finite and non-negative, got {value!r}")
         for name in ("gyr_offset", "acc_offset"):
             v = np.asarray(getattr(self, name), dtype=float)
             if v.shape != (3,) or not np.isfinite(v).all():
                 raise ValueError(f"{name} must be 3 finite numbers, got {getattr(self, name)!r}")
 
     def measure(self, omega, f, noise, fs: float):
-        """Measured (gyr, acc) from ideal rate omega, specific force f and unit-normal noise (…×3)."""
-        sigma = self.delta_n * math.sqrt(fs / 2.0)
-        gyr = np.asarray(omega) + sigma * np.asarray(noise) + np.asarray(self.gyr_offset)
-        return gyr, np.asarray(f) + np.asarray(self.acc_offset)
+        """Measured (gyr, acc) from ideal rate omega, specific force f (…×3) and unit-normal
+        noise (…×6: gyro, then accelerometer) at sample rate fs (Hz)."""
+        noise = np.asarray(noise)
+        scale = math.sqrt(fs / 2.0)
+        gyr = np.asarray(omega) + self.delta_n * scale * noise[..., 0:3] + np.asarray(self.gyr_offset)
+        acc = np.asarray(f) + self.acc_noise * scale * noise[..., 3:6] + np.asarray(self.acc_offset)
+        return gyr, acc
 
     def apply(self, motion: Motion, seed: int = 1) -> tuple[np.ndarray, np.ndarray]:
         """Measured (gyr, acc) of a motion, with noise drawn from a fixed seed."""
-        noise = np.random.default_rng(seed).standard_normal(motion.gyr.shape)
+        noise = np.random.default_rng(seed).standard_normal((len(motion.gyr), 6))
         return self.measure(motion.gyr, motion.acc, noise, motion.fs)
 
     def system(self, fs: float, name: str = "imu"):
-        """Discrete python-control system: inputs omega_*, f_*, n_* (unit normal); outputs gyr_*, acc_*."""
+        """Discrete python-control system: inputs omega_*, f_*, n_*, na_* (unit normal);
+        outputs gyr_*, acc_*."""
         def output(t, x, u, params):
-            gyr, acc = self.measure(u[0:3], u[3:6], u[6:9], fs)
+            gyr, acc = self.measure(u[0:3], u[3:6], u[6:12], fs)
             return np.concatenate([gyr, acc])
 
         return control.nlsys(
             None, output, name=name, dt=1.0 / fs,
-            inputs=[f"omega_{a}" for a in AXES] + [f"f_{a}" for a in AXES] + [f"n_{a}" for a in AXES],
+            inputs=[f"{s}_{a}" for s in ("omega", "f", "n", "na") for a in AXES],
             outputs=[f"gyr_{a}" for a in AXES] + [f"acc_{a}" for a in AXES],
         )

@@ -26,27 +26,30 @@ def test_human_motion_truth_is_exact_and_has_the_eq14_velocity_spectrum():
 def test_sensor_model_noise_density_and_offsets():
     motion = HumanMotion().generate(1000.0, 200.0, seed=1)
     dn = math.radians(0.1)
-    gyr, acc = ImuModel(delta_n=dn, gyr_offset=(0.01, -0.02, 0.03), acc_offset=(1, 1, 1)).apply(motion)
-    noise = gyr - motion.gyr
-    assert noise.mean(axis=0) == pytest.approx([0.01, -0.02, 0.03], abs=3 * dn * 10 / math.sqrt(len(noise)))
-    # one-sided density δn at 200 Hz: per-sample s.d. δn·√(fs/2)
-    assert noise.std(axis=0) == pytest.approx(np.full(3, dn * math.sqrt(100.0)), rel=0.01)
-    assert np.allclose(acc - motion.acc, 1.0)
+    model = ImuModel(delta_n=dn, gyr_offset=(0.01, -0.02, 0.03), acc_noise=0.002, acc_offset=(1, 1, 1))
+    gyr, acc = model.apply(motion)
+    for error, density, offset in ((gyr - motion.gyr, dn, [0.01, -0.02, 0.03]), (acc - motion.acc, 0.002, [1, 1, 1])):
+        # one-sided density at 200 Hz: per-sample s.d. density·√(fs/2)
+        sd = density * math.sqrt(100.0)
+        assert error.mean(axis=0) == pytest.approx(offset, abs=4 * sd / math.sqrt(len(error)))
+        assert error.std(axis=0) == pytest.approx(np.full(3, sd), rel=0.01)
     with pytest.raises(ValueError):
         ImuModel(delta_n=-1.0)
 
 
 def test_steady_lever_arm_closed_form():
-    m = steady_lever_arm(2.0, 0.2, duration=10.0, fs=100.0, g=9.81)
+    m = steady_lever_arm(2.0, 0.2, g=9.81).generate(10.0, 100.0)
     rot = Rotation.from_quat(m.quat, scalar_first=True)
     assert np.abs((rot[:-1].inv() * rot[1:]).as_rotvec() - m.gyr[1:] / 100.0).max() < 1e-12
-    # specific force in sensor coordinates is constant: gravity plus 0.8 m/s² towards the axis
+    # specific force in sensor coordinates is constant: gravity plus Ω²r = 0.8 m/s² towards the
+    # axis, averaged over each sample interval (a chord of the velocity circle)
     assert np.ptp(m.acc, axis=0).max() < 1e-12
-    assert np.linalg.norm(rot.apply(m.acc)[0] - [0, 0, 9.81]) == pytest.approx(0.8, rel=1e-12)
+    chord = 0.2 * 2.0 * 2 * math.sin(2.0 * 0.01 / 2) / 0.01
+    assert np.linalg.norm(rot.apply(m.acc)[0] - [0, 0, 9.81]) == pytest.approx(chord, rel=1e-12)
 
 
 def test_incline_motion_has_zero_mean_acceleration_and_the_stated_peak():
-    m = incline_oscillation(duration=10.0, fs=1000.0, g=9.81)
+    m = incline_oscillation(g=9.81).generate(10.0, 1000.0)
     earth = Rotation.from_quat(m.quat, scalar_first=True).apply(m.acc) - [0, 0, 9.81]
     assert np.abs(earth.mean(axis=0)).max() < 1e-9
     assert np.linalg.norm(earth, axis=1).max() == pytest.approx(math.sqrt(2) * 9.81, rel=1e-4)
@@ -55,13 +58,13 @@ def test_incline_motion_has_zero_mean_acceleration_and_the_stated_peak():
 
 def test_closed_loop_diagram_equals_the_batch_pipeline():
     motion = HumanMotion()
-    imu = ImuModel(delta_n=math.radians(0.1), gyr_offset=(0.01, 0.0, -0.01))
+    imu = ImuModel(delta_n=math.radians(0.1), gyr_offset=(0.01, 0.0, -0.01), acc_noise=0.01)
     fs = 100.0
     noise, resp = simulate_closed_loop(motion, imu, fs, duration=5.0, seed=3)
     state = motion.initial_state()
     truth = np.empty((len(noise), 10))
     _human_run(state, np.ascontiguousarray(noise[:, :6]), motion.coefficients(fs), truth)
-    gyr, acc = imu.measure(truth[:, 0:3], truth[:, 3:6], noise[:, 6:9], fs)
+    gyr, acc = imu.measure(truth[:, 0:3], truth[:, 3:6], noise[:, 6:12], fs)
     est = estimate(gyr, acc, fs, initial_gravity=[0, 0, motion.g])
     up = Rotation.from_quat(truth[:, 6:10], scalar_first=True).inv().apply([0, 0, 1])
     assert np.abs(resp.outputs[1:4].T - est.gravity).max() <= 1e-12

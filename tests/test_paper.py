@@ -64,7 +64,7 @@ def test_centripetal_acceleration_biases_sensor_frame_lowpass_not_the_estimator(
     assert r["estimator_mean_deg"] < 0.05
     assert r["estimator_bias_deg"] < 0.05
     # eq. 19: the low-pass keeps the mean centripetal acceleration (0.8 m/s² here)
-    assert r["centripetal_m_s2"] == pytest.approx(0.8, rel=1e-6)
+    assert r["centripetal_m_s2"] == pytest.approx(0.8, rel=1e-4)
     assert r["lowpass_mean_deg"] == pytest.approx(r["eq19_predicted_deg"], rel=0.02)
     assert r["lowpass_mean_deg"] == pytest.approx(math.degrees(math.atan(0.8 / ex.PAPER_G)), rel=0.02)
 

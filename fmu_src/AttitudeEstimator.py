@@ -1,0 +1,84 @@
+"""AttitudeEstimator.fmu: the project's attitude estimators as an FMI 2.0 co-simulation FMU.
+
+Each doStep(t, h) takes gyr (mean rate over (t, t+h]) and acc, mag at t+h, and steps the
+same compiled block as `attitude estimate` (blocks.online.OnlineEstimator). A parameter
+of 0 means "the method's default"; parameters a method does not have must stay 0.
+"""
+from __future__ import annotations
+
+import math
+
+from fmu_support import IN, OUT, PAR, Fmi2Status, ProjectSlave
+
+from blocks.methods import METHODS
+from blocks.online import OnlineEstimator
+from systems.motion import EARTH_FIELD_UT
+
+# FMI unit names for the methods' parameter units
+FMI_UNIT = {"rad/s/√Hz": "rad/s/sqrt(Hz)", "m/s/√Hz": "m/s/sqrt(Hz)", "m/s²": "m/s2", "rad/s": "rad/s"}
+
+
+def tuning_parameters():
+    """Every method's tuning parameters, once each: name → (FMI unit, description)."""
+    params = {}
+    for m in METHODS.values():
+        for p in m.params:
+            params.setdefault(p.name, (FMI_UNIT[p.unit], f"{p.doc}; 0: the method's default"))
+    return params
+
+
+class AttitudeEstimator(ProjectSlave):
+    author = "attitude-fmu"
+    description = "IMU attitude estimator (Rizun's optimal Wiener filter and peers); gravity up, ENU, q sensor->earth"
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.vector("gyr", (0.0, 0.0, 0.0), "rad/s", "gyro {c}, mean rate over the step", IN)
+        self.vector("acc", (0.0, 0.0, 9.81), "m/s2", "specific force {c} at the end of the step", IN)
+        self.vector("mag", EARTH_FIELD_UT, "uT", "magnetic field {c} (unused by the 6D methods)", IN)
+        self.vector("q", (1.0, 0.0, 0.0, 0.0), "1", "orientation quaternion {c}, sensor -> earth (ENU)", OUT, "wxyz")
+        self.vector("g", (0.0, 0.0, 1.0), "1", "estimated unit up-vector {c}, sensor coordinates", OUT)
+        for name in ("roll", "pitch", "yaw"):
+            self.real(name, 0.0, "rad", f"{name} (Z-Y-X Euler angles of q; derived output)", OUT)
+        self.boolean_output("valid", False, "an estimate is available and the last inputs were finite")
+        self.parameter("method", "wiener", f"estimator: {', '.join(METHODS)}")
+        self.real("Ts", 0.01, "s", "sample time the estimator expects (other step sizes are re-discretised)", PAR)
+        for name, (unit, doc) in tuning_parameters().items():
+            self.real(name, 0.0, unit, doc, PAR)
+        self.estimator = None
+        self._warned_steps = set()
+
+    def exit_initialization_mode(self):
+        if not (math.isfinite(self.Ts) and self.Ts > 0):
+            self.fail(f"Ts must be a finite positive number of seconds, got {self.Ts!r}")
+        params = {name: getattr(self, name) for name in tuning_parameters() if getattr(self, name) != 0.0}
+        try:
+            self.estimator = OnlineEstimator(self.method, params)
+        except ValueError as exc:
+            self.fail(f"invalid parameter: {exc}")
+
+    def do_step(self, current_time, step_size):
+        if self.estimator is None:
+            self.fail("doStep before initialisation")
+        if step_size != self.Ts and step_size not in self._warned_steps:
+            self._warned_steps.add(step_size)
+            self.log(f"communication step {step_size:g} s differs from Ts = {self.Ts:g} s: "
+                     "filter re-discretised for it", Fmi2Status.warning)
+        io = self.estimator.io
+        io[0], io[1], io[2] = self.gyr_x, self.gyr_y, self.gyr_z
+        io[3], io[4], io[5] = self.acc_x, self.acc_y, self.acc_z
+        try:
+            self.valid = self.estimator.step_io(step_size)
+        except ValueError as exc:
+            self.fail(str(exc))
+        if self.valid:
+            (self.q_w, self.q_x, self.q_y, self.q_z, self.g_x, self.g_y, self.g_z,
+             self.roll, self.pitch, self.yaw) = io[6:16].tolist()
+        elif not all(math.isfinite(v) for v in io[0:6].tolist()):
+            self.log(f"t={current_time:g}: non-finite input; estimate held", Fmi2Status.warning)
+        return True
+
+    def reset(self):
+        if self.estimator is not None:
+            self.estimator.reset()
+        self.valid = False

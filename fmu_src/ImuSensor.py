@@ -1,0 +1,58 @@
+"""ImuSensor.fmu: ideal motion signals in, measured IMU signals out (systems.sensor_model.ImuModel).
+
+Noise is drawn per step from numpy's generator seeded with `seed`, in the order the
+batch path draws it, so a run equals ImuModel.apply on the same samples.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from fmu_support import IN, OUT, PAR, Integer, ProjectSlave
+
+from systems.motion import EARTH_FIELD_UT
+from systems.sensor_model import ImuModel
+
+
+
+class ImuSensor(ProjectSlave):
+    author = "attitude-fmu"
+    description = "IMU sensor model: gyro noise density and offset, accelerometer noise and offset"
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.vector("omega", (0.0, 0.0, 0.0), "rad/s", "true angular rate {c}, mean over the step", IN)
+        self.vector("f", (0.0, 0.0, 9.81), "m/s2", "true specific force {c}", IN)
+        self.vector("m", EARTH_FIELD_UT, "uT", "true magnetic field {c}", IN)
+        self.vector("gyr", (0.0, 0.0, 0.0), "rad/s", "measured angular rate {c}", OUT)
+        self.vector("acc", (0.0, 0.0, 9.81), "m/s2", "measured specific force {c}", OUT)
+        self.vector("mag", EARTH_FIELD_UT, "uT", "measured magnetic field {c} (ideal)", OUT)
+        self.real("delta_n", 0.0, "rad/s/sqrt(Hz)", "gyro white-noise density, one-sided", PAR)
+        self.vector("gyr_offset", (0.0, 0.0, 0.0), "rad/s", "constant gyro offset {c}", PAR)
+        self.real("acc_noise", 0.0, "m/s2/sqrt(Hz)", "accelerometer white-noise density, one-sided", PAR)
+        self.vector("acc_offset", (0.0, 0.0, 0.0), "m/s2", "constant accelerometer offset {c}", PAR)
+        self.parameter("seed", 1, "seed of the noise generator", Integer)
+        self.model = None
+
+    def exit_initialization_mode(self):
+        try:
+            self.model = ImuModel(
+                delta_n=self.delta_n, acc_noise=self.acc_noise,
+                gyr_offset=(self.gyr_offset_x, self.gyr_offset_y, self.gyr_offset_z),
+                acc_offset=(self.acc_offset_x, self.acc_offset_y, self.acc_offset_z),
+            )
+        except ValueError as exc:
+            self.fail(f"invalid parameter: {exc}")
+        self.rng = np.random.default_rng(self.seed)
+
+    def do_step(self, current_time, step_size):
+        if not (math.isfinite(step_size) and step_size > 0):
+            self.fail(f"step size must be positive, got {step_size!r}")
+        gyr, acc = self.model.measure(
+            (self.omega_x, self.omega_y, self.omega_z), (self.f_x, self.f_y, self.f_z),
+            self.rng.standard_normal(6), 1.0 / step_size,
+        )
+        self.gyr_x, self.gyr_y, self.gyr_z = (float(v) for v in gyr)
+        self.acc_x, self.acc_y, self.acc_z = (float(v) for v in acc)
+        self.mag_x, self.mag_y, self.mag_z = self.m_x, self.m_y, self.m_z
+        return True

@@ -1,0 +1,17 @@
+"""NoOpEstimator.fmu: AttitudeEstimator's interface with nothing behind it.
+
+Built only by the FMU benchmark, to measure what the FMI plumbing alone costs per step.
+"""
+from __future__ import annotations
+
+from AttitudeEstimator import AttitudeEstimator
+
+
+class NoOpEstimator(AttitudeEstimator):
+    description = "AttitudeEstimator's interface; doStep does nothing (benchmark baseline)"
+
+    def exit_initialization_mode(self):
+        pass
+
+    def do_step(self, current_time, step_size):
+        return True

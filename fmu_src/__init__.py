@@ -1,0 +1,1 @@
+"""Sources of the project's FMUs: thin pythonfmu adapters over blocks/ and systems/."""

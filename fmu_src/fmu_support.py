@@ -1,0 +1,95 @@
+"""FMI plumbing shared by the project's FMUs (pythonfmu): units on Real variables, the
+UnitDefinitions they refer to, and compact registration of variables.
+
+The models' equations live in `blocks/` and `systems/`; an FMU here only maps FMI
+variables onto them.
+"""
+from __future__ import annotations
+
+from xml.etree.ElementTree import Element, SubElement
+
+from pythonfmu import Boolean, Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Integer, Real, String
+from pythonfmu.enums import Fmi2Status
+
+# FMI unit name → SI base-unit exponents (FMI 2.0 BaseUnit attributes); None for the
+# noise densities per √Hz, whose half-integer exponents FMI 2.0 cannot state
+UNITS = {
+    "s": {"s": 1},
+    "Hz": {"s": -1},
+    "m": {"m": 1},
+    "rad": {"rad": 1},
+    "deg": {"rad": 1, "factor": 0.017453292519943295},
+    "rad/s": {"rad": 1, "s": -1},
+    "rad/s/sqrt(Hz)": None,
+    "m/s/sqrt(Hz)": None,
+    "m/s2/sqrt(Hz)": None,
+    "m/s2": {"m": 1, "s": -2},
+    "uT": {"kg": 1, "s": -2, "A": -1, "factor": 1e-6},
+    "1": {},
+}
+
+
+IN, OUT, PAR = Fmi2Causality.input, Fmi2Causality.output, Fmi2Causality.parameter
+
+
+class UnitReal(Real):
+    """A pythonfmu Real with an FMI unit attribute."""
+
+    def __init__(self, name: str, unit: str, **kwargs):
+        if unit not in UNITS:
+            raise ValueError(f"unit {unit!r} has no definition in fmu_support.UNITS")
+        super().__init__(name, **kwargs)
+        self.unit = unit
+
+    def to_xml(self) -> Element:
+        node = super().to_xml()
+        node.find("Real").set("unit", self.unit)
+        return node
+
+
+class ProjectSlave(Fmi2Slave):
+    """Fmi2Slave with units and helpers; subclasses register their variables."""
+
+    def to_xml(self, model_options=None) -> Element:
+        root = super().to_xml(model_options or {})
+        used = sorted({v.unit for v in self.vars.values() if isinstance(v, UnitReal)})
+        definitions = Element("UnitDefinitions")
+        for name in used:
+            unit = SubElement(definitions, "Unit", name=name)
+            if UNITS[name] is not None:
+                SubElement(unit, "BaseUnit", {k: str(v) for k, v in UNITS[name].items()})
+        root.insert(list(root).index(root.find("CoSimulation")) + 1, definitions)
+        return root
+
+    def real(self, name, start, unit, description, causality):
+        """Register a Real input, output or (fixed) parameter held in attribute `name`."""
+        setattr(self, name, float(start))
+        variability = Fmi2Variability.fixed if causality == Fmi2Causality.parameter else Fmi2Variability.continuous
+        # outputs start exact: pythonfmu writes no InitialUnknowns for calculated ones
+        extra = {"initial": Fmi2Initial.exact} if causality == Fmi2Causality.output else {}
+        self.register_variable(UnitReal(name, unit, causality=causality, variability=variability,
+                                        description=description, **extra), nested=False)
+
+    def vector(self, prefix, start, unit, description, causality, components="xyz"):
+        """Register prefix_<c> for each component c; description may use {c}."""
+        for c, value in zip(components, start):
+            self.real(f"{prefix}_{c}", value, unit, description.format(c=c), causality)
+
+    def parameter(self, name, start, description, kind=String):
+        """Register a fixed String, Integer or Boolean parameter held in attribute `name`."""
+        setattr(self, name, start)
+        self.register_variable(kind(name, causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,
+                                    description=description), nested=False)
+
+    def boolean_output(self, name, start, description):
+        setattr(self, name, start)
+        self.register_variable(Boolean(name, causality=Fmi2Causality.output, variability=Fmi2Variability.discrete,
+                                       initial=Fmi2Initial.exact, description=description), nested=False)
+
+    def fail(self, message: str):
+        """Log an error and raise, so that the FMI call returns fmi2Error."""
+        self.log(message, Fmi2Status.error)
+        raise ValueError(message)
+
+
+__all__ = ["ProjectSlave", "Fmi2Status", "Integer", "String", "UNITS", "IN", "OUT", "PAR"]

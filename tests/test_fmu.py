@@ -1,0 +1,233 @@
+"""The FMUs: validation, equality with the batch path, FMI robustness, the SSP diagram."""
+import json
+import math
+import os
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+from fmpy.fmi1 import FMICallException
+from fmpy.ssp.simulation import simulate_ssp
+from fmpy.validation import validate_fmu
+
+from blocks.methods import METHODS
+from systems.batch import estimate
+from systems.cosim import FmuRunner, cosimulate
+from systems.fmu_build import FMU_NAMES, build
+from systems.motion import HumanMotion, profile
+from systems.sensor_model import ImuModel
+from systems.ssp import write_ssp
+
+INPUTS = [f"{s}_{a}" for s in ("gyr", "acc") for a in "xyz"]
+OUTPUTS = ["q_w", "q_x", "q_y", "q_z", "g_x", "g_y", "g_z"]
+FS = 100.0
+
+
+@pytest.fixture(scope="module")
+def fmu_dir(tmp_path_factory):
+    out = tmp_path_factory.mktemp("fmus")
+    build(out)
+    return out
+
+
+@pytest.fixture(scope="module")
+def recording():
+    motion = HumanMotion(delta_v=0.1, omega_c=5.0).generate(10.0, FS, seed=21)
+    gyr, acc = ImuModel(delta_n=math.radians(0.05)).apply(motion, seed=22)
+    return gyr, acc
+
+
+def _estimator(fmu_dir, **parameters):
+    return FmuRunner(fmu_dir / "AttitudeEstimator.fmu", parameters, INPUTS, OUTPUTS, logging=True)
+
+
+def test_every_fmu_validates(fmu_dir):
+    for name in FMU_NAMES:
+        assert validate_fmu(str(fmu_dir / f"{name}.fmu")) == [], name
+
+
+@pytest.mark.parametrize("method", sorted(METHODS))
+def test_estimator_fmu_equals_the_batch_path(fmu_dir, recording, method):
+    gyr, acc = recording
+    runner = _estimator(fmu_dir, method=method, delta_n=0.002)
+    out, valid = runner.run(np.hstack([gyr, acc]), 1 / FS)
+    runner.close()
+    ref = estimate(gyr, acc, FS, method, {"delta_n": 0.002})
+    assert valid.all()
+    assert np.abs(out[:, :4] - ref.quat).max() < 1e-9
+    assert np.abs(out[:, 4:] - ref.up).max() < 1e-9
+
+
+def test_reset_then_second_run_is_identical(fmu_dir, recording):
+    gyr, acc = recording
+    runner = _estimator(fmu_dir, method="first_order")
+    first, _ = runner.run(np.hstack([gyr, acc])[:300], 1 / FS)
+    runner.reset()
+    second, _ = runner.run(np.hstack([gyr, acc])[:300], 1 / FS)
+    runner.close()
+    assert np.array_equal(first, second)
+
+
+def test_instances_in_one_process_stay_independent(fmu_dir, recording):
+    gyr, acc = recording
+    a, b = _estimator(fmu_dir), _estimator(fmu_dir, delta_v=3.0)
+    data = np.hstack([gyr, acc])[:300]
+    out_a = np.array([a.step(row, 1 / FS)[0] for row in data[:, :]])
+    # b sees the recording rotated about z: an independent input stream, interleaved with a
+    other = np.hstack([gyr[:300, [1, 0, 2]] * [1, -1, 1], acc[:300, [1, 0, 2]] * [1, -1, 1]])
+    out_b = np.empty_like(out_a)
+    for k, row in enumerate(other):
+        out_b[k] = b.step(row, 1 / FS)[0]
+        a.step(data[k], 1 / FS)  # a keeps stepping in between
+    a.close()
+    b.close()
+    assert np.abs(out_a[:, :4] - estimate(gyr[:300], acc[:300], FS).quat).max() < 1e-9
+    ref_b = estimate(other[:, :3], other[:, 3:], FS, params={"delta_v": 3.0})
+    assert np.abs(out_b[:, :4] - ref_b.quat).max() < 1e-9
+
+
+def test_changed_step_size_is_rediscretised_and_logged(fmu_dir, recording, capsys):
+    gyr, acc = recording
+    runner = _estimator(fmu_dir)
+    data = np.hstack([gyr, acc])[:200]
+    out = np.array([runner.step(row, 0.01 if k < 100 else 0.02)[0] for k, row in enumerate(data)])
+    runner.close()
+    assert "differs from Ts" in capsys.readouterr().out
+    # the same as the batch path over both halves, each at its own rate, carried across
+    first = estimate(gyr[:100], acc[:100], 100.0)
+    from blocks.online import OnlineEstimator
+
+    online = OnlineEstimator()
+    expected = []
+    for k, row in enumerate(data):
+        online.step(row[:3], row[3:], 0.01 if k < 100 else 0.02)
+        expected.append(online.io[6:10].copy())
+    assert np.abs(out[:100, :4] - first.quat).max() < 1e-9
+    assert np.abs(out[:, :4] - np.array(expected)).max() < 1e-9
+
+
+@pytest.mark.parametrize("parameters, message", [
+    ({"delta_n": -1.0}, "delta_n must be a finite positive number"),
+    ({"method": "kalman"}, "unknown method 'kalman'"),
+    ({"method": "wiener", "omega_f": 0.1}, "unknown parameter 'omega_f'"),
+])
+def test_invalid_parameter_fails_initialisation_with_a_clear_log_message(fmu_dir, parameters, message, capsys):
+    """pythonfmu 0.7 reports any Python exception as fmi2Fatal; the message says why."""
+    with pytest.raises(FMICallException) as info:
+        _estimator(fmu_dir, **parameters)
+    assert info.value.status in (3, 4)  # fmi2Error or fmi2Fatal
+    log = capsys.readouterr().out
+    assert "[ERROR] invalid parameter" in log and message in log, log
+
+
+def test_non_finite_inputs_hold_the_estimate_and_clear_valid(fmu_dir, recording, capsys):
+    gyr, acc = recording
+    runner = _estimator(fmu_dir)
+    data = np.hstack([gyr, acc])[:50].copy()
+    data[20, 4] = np.nan
+    data[21, 0] = np.inf
+    out, valid = runner.run(data, 1 / FS)
+    runner.close()
+    assert "non-finite input" in capsys.readouterr().out
+    assert not valid[20] and not valid[21] and valid[:20].all() and valid[22:].all()
+    assert np.array_equal(out[20], out[19]) and np.array_equal(out[21], out[19])
+    # the held samples are skipped: afterwards the estimate goes on from sample 19's state
+    kept = np.delete(data, [20, 21], axis=0)
+    ref = estimate(kept[:, :3], kept[:, 3:], FS)
+    assert np.abs(out[22:, :4] - ref.quat[20:]).max() < 1e-9
+
+
+def _batch_pipeline(duration, seed_motion, seed_imu, delta_n, method="wiener"):
+    motion = profile("human").motion().generate(duration, FS, seed_motion)
+    gyr, acc = ImuModel(delta_n=delta_n).apply(motion, seed_imu)
+    return motion, estimate(gyr, acc, FS, method)
+
+
+@pytest.mark.parametrize("method", sorted(METHODS))
+def test_ssp_diagram_under_the_master_equals_the_batch_pipeline(fmu_dir, tmp_path, method):
+    dn = math.radians(0.1)
+    ssp = write_ssp(tmp_path / "human.ssp", fmu_dir, {
+        "motion": {"profile": "human", "seed": 3}, "imu": {"delta_n": dn, "seed": 4},
+        "estimator": {"method": method}}, 10.0, 1 / FS)
+    out = cosimulate(ssp, 10.0, 1 / FS)
+    motion, ref = _batch_pipeline(10.0, 3, 4, dn, method)
+    assert np.abs(np.column_stack([out[f"motion.qt_{c}"] for c in "wxyz"]) - motion.quat).max() < 1e-12
+    assert np.abs(np.column_stack([out[f"estimator.q_{c}"] for c in "wxyz"]) - ref.quat).max() < 1e-9
+    assert out["estimator.valid"].all()
+
+
+def test_fmpy_simulate_ssp_runs_the_same_diagram_one_step_per_connection_later(fmu_dir, tmp_path):
+    """fmpy's own SSP simulation (no String parameters, Jacobi stepping) on the default
+    configuration gives the master's estimates two steps later (two connections)."""
+    ssp = write_ssp(tmp_path / "default.ssp", fmu_dir, {}, 5.0, 1 / FS)
+    ours = cosimulate(ssp, 5.0, 1 / FS)
+    theirs = simulate_ssp(str(ssp), stop_time=5.0, step_size=1 / FS)
+    q_theirs = np.column_stack([theirs[f"estimator.q_{c}"] for c in "wxyz"])
+    q_ours = np.column_stack([ours[f"estimator.q_{c}"] for c in "wxyz"])
+    n = len(q_ours)
+    assert not theirs["estimator.valid"][:2].any()  # connectors start at 0: no gravity yet
+    assert np.abs(q_theirs[2:n] - q_ours[: n - 2]).max() < 1e-12
+
+
+def test_fmu_runs_in_a_fresh_environment_without_the_project(fmu_dir, recording, tmp_path):
+    """A virtual environment with numpy, scipy, control, pythonfmu and fmpy only (no numba,
+    not this project): the FMU's resources carry the code, and it gives the batch numbers."""
+    venv = tmp_path / "venv"
+    subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True)
+    python = venv / "bin" / "python"
+    subprocess.run([str(python), "-m", "pip", "install", "--quiet", "numpy", "scipy", "control", "pythonfmu", "fmpy"],
+                   check=True, capture_output=True)
+    gyr, acc = recording
+    np.save(tmp_path / "inputs.npy", np.hstack([gyr, acc])[:200])
+    script = textwrap.dedent(f"""
+        import json, sys, numpy as np
+        from fmpy import extract, read_model_description
+        from fmpy.fmi2 import FMU2Slave
+        try:
+            import blocks
+            sys.exit("the project is importable here")
+        except ImportError:
+            pass
+        path = {str(fmu_dir / "AttitudeEstimator.fmu")!r}
+        md = read_model_description(path)
+        vr = {{v.name: v.valueReference for v in md.modelVariables}}
+        fmu = FMU2Slave(guid=md.guid, unzipDirectory=extract(path), instanceName="fresh",
+                        modelIdentifier=md.coSimulation.modelIdentifier)
+        fmu.instantiate(); fmu.setupExperiment(startTime=0); fmu.enterInitializationMode(); fmu.exitInitializationMode()
+        rows = []
+        for k, row in enumerate(np.load({str(tmp_path / "inputs.npy")!r})):
+            fmu.setReal([vr[n] for n in {INPUTS!r}], row.tolist())
+            fmu.doStep(currentCommunicationPoint=k / {FS}, communicationStepSize=1 / {FS})
+            rows.append(fmu.getReal([vr[n] for n in {OUTPUTS!r}]))
+        print(json.dumps(rows))
+    """)
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV")}
+    proc = subprocess.run([str(python), "-c", script], capture_output=True, text=True, cwd=tmp_path, env=env)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    out = np.array(json.loads(proc.stdout.strip().splitlines()[-1]))
+    ref = estimate(gyr[:200], acc[:200], FS)
+    assert np.abs(out[:, :4] - ref.quat).max() < 1e-9
+    assert np.abs(out[:, 4:] - ref.up).max() < 1e-9
+
+
+def test_verify_cli_json_contract_and_exit_status(fmu_dir, monkeypatch, capsys):
+    from systems import verify as verify_module
+    from systems.cli import main
+
+    # a short run of one scenario: the full table is the main job (`attitude verify`)
+    monkeypatch.setitem(verify_module.SCENARIOS, "incline", verify_module.Scenario(240.0, "mean"))
+    args = ["verify", "--json", "--fmu-dir", str(fmu_dir), "--profile", "incline", "--method", "wiener"]
+    assert main(args) == 0
+    (row,) = json.loads(capsys.readouterr().out)["rows"]
+    assert {"profile", "method", "rms_deg", "bound_deg", "pass"} <= set(row)
+    assert row["profile"] == "incline" and row["method"] == "wiener" and row["pass"]
+    assert row["mean_deg"] < 0.05
+    # a bound that cannot be met fails the run
+    monkeypatch.setattr(verify_module, "BIAS_BOUND_DEG", -1.0)
+    assert main(args) == 1
+    assert main(["verify", "--fmu-dir", str(fmu_dir), "--profile", "nowhere"]) == 2
+    monkeypatch.setitem(verify_module.SCENARIOS, "incline", verify_module.Scenario(60.0, "mean"))
+    assert main(args) == 2
+    assert "too short" in capsys.readouterr().err
