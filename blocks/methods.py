@@ -1,7 +1,10 @@
-"""Estimator methods by name: their documented parameters and their earth-frame filter.
+"""Estimator methods by name: their documented parameters and their per-sample step.
 
-Every method here is an earth-frame LTI filter carried into the sensor frame by
-`sensor_frame.sensor_frame_system`; the name is the one `attitude estimate --method` takes.
+A method is either an earth-frame LTI filter carried into the sensor frame
+(`sensor_frame`), or a compiled kernel of its own (`kernel`: a module with STATE_SIZE,
+coefficients, initial_state and run). Both are driven through a Stepper, which the batch
+path, the python-control block and the FMU share. Names are those of `attitude estimate
+--method`.
 """
 from __future__ import annotations
 
@@ -12,8 +15,12 @@ from typing import Callable, Mapping
 
 import control
 
+import numpy as np
+
 from . import earth_filters as ef
-from .sensor_frame import DiscreteFilter
+from . import luinge, mahony, tseng, tseng_adaptive
+from .sensor_frame import DiscreteFilter, SensorFrameStepper
+from .stepper_system import stepper_system
 
 
 @dataclass(frozen=True)
@@ -24,14 +31,19 @@ class Param:
     default: float | None
     unit: str
     doc: str
+    allow_zero: bool = False
 
 
 @dataclass(frozen=True)
 class Method:
+    """design gives the earth-frame filter of a sensor-frame method; kernel is the module
+    of a method with a step of its own (exactly one of the two)."""
+
     name: str
     summary: str
     params: tuple[Param, ...]
-    design: Callable[[Mapping[str, float | None]], control.TransferFunction]
+    design: Callable[[Mapping[str, float | None]], control.TransferFunction] | None = None
+    kernel: object = None
 
     def resolve(self, overrides: Mapping[str, float] | None = None) -> dict[str, float | None]:
         """Defaults updated by overrides; unknown names and non-positive values are refused."""
@@ -42,13 +54,22 @@ class Method:
                     f"unknown parameter {name!r} for method {self.name!r}; "
                     f"known: {', '.join(known)}"
                 )
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-                raise ValueError(f"parameter {name} must be a finite positive number, got {value!r}")
+            param = next(p for p in self.params if p.name == name)
+            low_ok = value >= 0 if param.allow_zero else value > 0
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and low_ok):
+                kind = "non-negative" if param.allow_zero else "positive"
+                raise ValueError(f"parameter {name} must be a finite {kind} number, got {value!r}")
             known[name] = float(value)
         return known
 
+    @property
+    def is_sensor_frame(self) -> bool:
+        return self.design is not None
+
     def filter(self, overrides: Mapping[str, float] | None = None) -> control.TransferFunction:
-        """The earth-frame filter for these parameters."""
+        """The earth-frame filter for these parameters (sensor-frame methods only)."""
+        if self.design is None:
+            raise ValueError(f"method {self.name!r} is not an earth-frame LTI filter")
         return self.design(self.resolve(overrides))
 
 
@@ -84,6 +105,43 @@ METHODS: dict[str, Method] = {
         ),
         _design_wiener,
     ),
+    "tseng": Method(
+        "tseng",
+        "Tseng's complementary filter (eqs. 6-11 with compensation), in the gyro-estimated earth frame",
+        (),
+        lambda p: tseng.earth_filter(),
+    ),
+    "tseng_adaptive": Method(
+        "tseng_adaptive",
+        "Tseng's adaptive filter: complementary filter, Mahony's filter while |acc| leaves g by > tol",
+        (
+            Param("tol", 0.5, "m/s²", "accelerometer norm's distance from g that switches to Mahony's filter"),
+            Param("k_P", 1.0, "1/s", "Mahony: proportional gain"),
+            Param("k_I", 0.3, "1/s²", "Mahony: integral gain of the gyro-bias estimate", True),
+            Param("g", ef.STANDARD_GRAVITY, "m/s²", "magnitude of gravity"),
+        ),
+        kernel=tseng_adaptive,
+    ),
+    "luinge": Method(
+        "luinge",
+        "Luinge's tilt Kalman filter: gyro orientation, 2-state KF on the tilt difference",
+        (
+            Param("delta_n", math.radians(0.1), "rad/s/√Hz", "gyro noise density (process noise of the tilt)"),
+            Param("tilt_sd", 0.05, "rad", "s.d. of the accelerometer's tilt (acceleration as noise)"),
+            Param("g", ef.STANDARD_GRAVITY, "m/s²", "magnitude of gravity (scales the gravity output)"),
+        ),
+        kernel=luinge,
+    ),
+    "mahony": Method(
+        "mahony",
+        "Mahony's complementary filter on SO(3) with gyro-bias estimation (IEEE TAC 53, 2008)",
+        (
+            Param("k_P", 1.0, "1/s", "proportional gain on the gravity-direction error"),
+            Param("k_I", 0.3, "1/s²", "integral gain of the gyro-bias estimate; 0: no bias estimate", True),
+            Param("g", ef.STANDARD_GRAVITY, "m/s²", "magnitude of gravity (scales the gravity output)"),
+        ),
+        kernel=mahony,
+    ),
     "first_order": Method(
         "first_order",
         "Rizun §4.2: first-order low-pass in the gyro-estimated earth frame",
@@ -108,3 +166,34 @@ def method(name: str) -> Method:
 def discrete_filter(name: str, params: tuple, Ts: float) -> DiscreteFilter:
     """Method name's filter for params ((name, value) pairs) at sample time Ts (s), designed once."""
     return DiscreteFilter.from_lti(method(name).filter(dict(params)), Ts)
+
+
+class KernelStepper:
+    """A method with a compiled kernel of its own: state and coefficients are 1-D arrays."""
+
+    def __init__(self, module, coef: np.ndarray):
+        self.module, self.coef = module, coef
+        self.state_names = list(module.STATE_NAMES)
+
+    def initial_state(self, acc0) -> np.ndarray:
+        return self.module.initial_state(self.coef, np.asarray(acc0, dtype=float))
+
+    def run(self, state, gyr, acc, gravity, quat) -> None:
+        self.module.run(state, self.coef, gyr, acc, gravity, quat)
+
+
+@lru_cache(maxsize=64)
+def stepper(name: str, params: tuple, Ts: float):
+    """The stepper of method name for params ((name, value) pairs) at sample time Ts (s)."""
+    m = method(name)
+    if m.is_sensor_frame:
+        return SensorFrameStepper(discrete_filter(name, params, Ts))
+    if not (math.isfinite(Ts) and Ts > 0):
+        raise ValueError(f"sample time Ts must be a finite positive number of seconds, got {Ts!r}")
+    return KernelStepper(m.kernel, m.kernel.coefficients(m.resolve(dict(params)), Ts))
+
+
+def estimator_system(name: str, params: Mapping[str, float] | None = None, dt: float = 0.01,
+                     system_name: str = "estimator"):
+    """Discrete python-control system of any method (see stepper_system.stepper_system)."""
+    return stepper_system(stepper(name, tuple(sorted((params or {}).items())), dt), dt, system_name)

@@ -23,12 +23,11 @@ import numpy as np
 from .jit import kernel
 
 from .quaternion import level_quat, quat_multiply, quat_normalized, quat_rotate, rotvec_quat
+from .stepper_system import INPUTS, OUTPUTS, stepper_system
 
 AXES = ("x", "y", "z")
-GYRO_INPUTS = [f"gyr_{a}" for a in AXES]
-ACC_INPUTS = [f"acc_{a}" for a in AXES]
-GRAVITY_OUTPUTS = [f"ghat_{a}" for a in AXES]
-QUAT_NAMES = ["q_w", "q_x", "q_y", "q_z"]
+GRAVITY_OUTPUTS = OUTPUTS[:3]
+QUAT_NAMES = OUTPUTS[3:]
 
 
 @dataclass(frozen=True)
@@ -63,6 +62,19 @@ class DiscreteFilter:
         """State X (n×3) the filter holds after resting with constant input acc0 (m/s²)."""
         unit = np.linalg.solve(np.eye(self.order) - self.Ad, self.Bd)
         return np.outer(unit, np.asarray(acc0, dtype=float))
+
+    def apply(self, x) -> np.ndarray:
+        """The filter on each column of x (N, or N×3), output k after input k, at rest on x[0].
+
+        This is the sensor-frame step with the gyro at zero: no rotation, plain LTI.
+        """
+        x = np.asarray(x, dtype=float)
+        columns = np.zeros((len(x), 3))
+        columns[:, : 1 if x.ndim == 1 else x.shape[1]] = x.reshape(len(x), -1)
+        out = np.empty_like(columns)
+        sensor_frame_run(np.zeros_like(columns), columns, self.Ad, self.Bd, self.C, self.D, self.Ts,
+                         self.rest_state(columns[0]), np.array([1.0, 0.0, 0.0, 0.0]), out, np.empty((len(x), 4)))
+        return out[:, 0] if x.ndim == 1 else out[:, : x.shape[1]]
 
 
 @kernel(inline=True)
@@ -115,6 +127,24 @@ def state_names(order: int) -> list[str]:
     return [f"x{j}_{a}" for j in range(order) for a in AXES]
 
 
+class SensorFrameStepper:
+    """The discrete sensor-frame filter as a stepper: state = [X row by row (3·n), q (4)]."""
+
+    def __init__(self, disc: DiscreteFilter):
+        self.disc = disc
+        self.state_names = state_names(disc.order) + QUAT_NAMES
+
+    def initial_state(self, acc0) -> np.ndarray:
+        """At rest on acc0 (m/s²), q = identity."""
+        return np.concatenate([self.disc.rest_state(acc0).ravel(), [1.0, 0.0, 0.0, 0.0]])
+
+    def run(self, state, gyr, acc, gravity, quat) -> None:
+        """Step over gyr, acc (N×3); state updated in place; gravity N×3, quat N×4 written."""
+        d, n = self.disc, self.disc.order
+        sensor_frame_run(gyr, acc, d.Ad, d.Bd, d.C, d.D, d.Ts, state[: 3 * n].reshape(n, 3), state[3 * n:],
+                         gravity, quat)
+
+
 def sensor_frame_system(earth_filter, dt: float | None = None, name: str = "estimator"):
     """python-control nonlinear I/O system of an earth-frame SISO filter in the sensor frame.
 
@@ -126,38 +156,12 @@ def sensor_frame_system(earth_filter, dt: float | None = None, name: str = "esti
     """
     if dt is None:
         return _continuous_system(_siso_state_space(earth_filter), name)
-    disc = DiscreteFilter.from_lti(earth_filter, dt)
-    n = disc.order
-
-    def advance(x, u):
-        X = np.array(x[: 3 * n], dtype=float).reshape(n, 3)
-        q = np.array(x[3 * n :], dtype=float)
-        g = np.empty((1, 3))
-        gyr = np.array(u[:3], dtype=float).reshape(1, 3)
-        acc = np.array(u[3:6], dtype=float).reshape(1, 3)
-        sensor_frame_step(
-            X, q, gyr, acc, 0, disc.Ad, disc.Bd, disc.C, disc.D, disc.Ts, np.empty((n, 3)), g
-        )
-        return X, q, g[0]
-
-    def update(t, x, u, params):
-        X, q, _ = advance(x, u)
-        return np.concatenate([X.ravel(), q])
-
-    def output(t, x, u, params):
-        _, q, g = advance(x, u)
-        return np.concatenate([g, q])
-
-    return control.nlsys(
-        update, output, inputs=GYRO_INPUTS + ACC_INPUTS, outputs=GRAVITY_OUTPUTS + QUAT_NAMES,
-        states=state_names(n) + QUAT_NAMES, dt=disc.Ts, name=name,
-    )
+    return stepper_system(SensorFrameStepper(DiscreteFilter.from_lti(earth_filter, dt)), dt, name)
 
 
 def initial_state(earth_filter, Ts: float, acc0) -> np.ndarray:
     """Initial state vector of the discrete system: at rest on acc0, q = identity."""
-    X = DiscreteFilter.from_lti(earth_filter, Ts).rest_state(acc0)
-    return np.concatenate([X.ravel(), [1.0, 0.0, 0.0, 0.0]])
+    return SensorFrameStepper(DiscreteFilter.from_lti(earth_filter, Ts)).initial_state(acc0)
 
 
 def _continuous_system(ss, name):
@@ -176,7 +180,7 @@ def _continuous_system(ss, name):
         return C @ np.reshape(x, (n, 3)) + D * np.asarray(u[3:6])
 
     return control.nlsys(
-        update, output, inputs=GYRO_INPUTS + ACC_INPUTS, outputs=GRAVITY_OUTPUTS,
+        update, output, inputs=INPUTS, outputs=GRAVITY_OUTPUTS,
         states=state_names(n), name=name,
     )
 

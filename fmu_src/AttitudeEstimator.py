@@ -8,14 +8,12 @@ from __future__ import annotations
 
 import math
 
-from fmu_support import IN, OUT, PAR, Fmi2Status, ProjectSlave
+from fmu_support import IN, OUT, PAR, Fmi2Status, ProjectSlave, fmi_unit
 
 from blocks.methods import METHODS
 from blocks.online import OnlineEstimator
 from systems.motion import EARTH_FIELD_UT
 
-# FMI unit names for the methods' parameter units
-FMI_UNIT = {"rad/s/√Hz": "rad/s/sqrt(Hz)", "m/s/√Hz": "m/s/sqrt(Hz)", "m/s²": "m/s2", "rad/s": "rad/s"}
 
 
 def tuning_parameters():
@@ -23,7 +21,7 @@ def tuning_parameters():
     params = {}
     for m in METHODS.values():
         for p in m.params:
-            params.setdefault(p.name, (FMI_UNIT[p.unit], f"{p.doc}; 0: the method's default"))
+            params.setdefault(p.name, (fmi_unit(p.unit), f"{p.doc}; 0: the method's default"))
     return params
 
 

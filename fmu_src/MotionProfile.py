@@ -6,12 +6,11 @@ named <profile>_<parameter>; 0 means the profile's default.
 """
 from __future__ import annotations
 
-from fmu_support import OUT, PAR, Integer, ProjectSlave
+from fmu_support import OUT, PAR, Integer, ProjectSlave, fmi_unit
 from scipy.spatial.transform import Rotation
 
 from systems.motion import EARTH_FIELD_UT, PROFILES, profile
 
-FMI_UNIT = {"m/s/√Hz": "m/s/sqrt(Hz)", "rad/s": "rad/s", "m": "m", "deg": "deg", "1": "1", "Hz": "Hz"}
 
 
 class MotionProfile(ProjectSlave):
@@ -30,7 +29,7 @@ class MotionProfile(ProjectSlave):
         self.real("g", 9.81, "m/s2", "magnitude of gravity", PAR)
         for prof in PROFILES.values():
             for p in prof.params:
-                self.real(f"{prof.name}_{p.name}", 0.0, FMI_UNIT[p.unit], f"{prof.name}: {p.doc}; 0: default {p.default:g}", PAR)
+                self.real(f"{prof.name}_{p.name}", 0.0, fmi_unit(p.unit), f"{prof.name}: {p.doc}; 0: default {p.default:g}", PAR)
         self.stream = None
 
     def exit_initialization_mode(self):

@@ -20,6 +20,8 @@ UNITS = {
     "rad": {"rad": 1},
     "deg": {"rad": 1, "factor": 0.017453292519943295},
     "rad/s": {"rad": 1, "s": -1},
+    "1/s": {"s": -1},
+    "1/s2": {"s": -2},
     "rad/s/sqrt(Hz)": None,
     "m/s/sqrt(Hz)": None,
     "m/s2/sqrt(Hz)": None,
@@ -30,6 +32,14 @@ UNITS = {
 
 
 IN, OUT, PAR = Fmi2Causality.input, Fmi2Causality.output, Fmi2Causality.parameter
+
+
+def fmi_unit(unit: str) -> str:
+    """The FMI unit name of a unit as the project documents it ("m/s²" → "m/s2", "√Hz" → "sqrt(Hz)")."""
+    name = unit.replace("√Hz", "sqrt(Hz)").replace("²", "2")
+    if name not in UNITS:
+        raise ValueError(f"unit {unit!r} has no FMI definition in fmu_support.UNITS")
+    return name
 
 
 class UnitReal(Real):
@@ -92,4 +102,4 @@ class ProjectSlave(Fmi2Slave):
         raise ValueError(message)
 
 
-__all__ = ["ProjectSlave", "Fmi2Status", "Integer", "String", "UNITS", "IN", "OUT", "PAR"]
+__all__ = ["ProjectSlave", "Fmi2Status", "Integer", "String", "UNITS", "IN", "OUT", "PAR", "fmi_unit"]

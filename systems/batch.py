@@ -7,8 +7,7 @@ from typing import Mapping
 
 import numpy as np
 
-from blocks.methods import discrete_filter
-from blocks.sensor_frame import sensor_frame_run
+from blocks.methods import stepper
 
 
 @dataclass
@@ -58,10 +57,9 @@ def estimate(
     by default the first accelerometer sample.
     """
     gyr, acc = check_imu(gyr, acc, fs)
-    disc = discrete_filter(method, tuple(sorted((params or {}).items())), 1.0 / fs)
-    X = disc.rest_state(acc[0] if initial_gravity is None else initial_gravity)
-    q = np.array([1.0, 0.0, 0.0, 0.0])
+    step = stepper(method, tuple(sorted((params or {}).items())), 1.0 / fs)
+    state = step.initial_state(acc[0] if initial_gravity is None else initial_gravity)
     gravity = np.empty_like(acc)
     quat = np.empty((acc.shape[0], 4))
-    sensor_frame_run(gyr, acc, disc.Ad, disc.Bd, disc.C, disc.D, disc.Ts, X, q, gravity, quat)
+    step.run(state, gyr, acc, gravity, quat)
     return AttitudeEstimate(gravity, quat)

@@ -1,4 +1,4 @@
-"""The `attitude` command line: estimate, table1, verify, bench."""
+"""The `attitude` command line: estimate, table1, verify, compare, bode, bench."""
 from __future__ import annotations
 
 import argparse
@@ -65,6 +65,14 @@ def build_parser() -> argparse.ArgumentParser:
     vf.add_argument("--profile", action="append", help="only this profile (repeatable)")
     vf.add_argument("--method", action="append", help="only this method (repeatable)")
 
+    cp = sub.add_parser("compare", help="every estimator and the peers vqf, madgwick on every motion profile")
+    cp.add_argument("--profile", action="append", help="only this profile (repeatable)")
+    cp.add_argument("--json", action="store_true")
+
+    bd = sub.add_parser("bode", help="frequency response of a method's filter (tseng: also Tseng Figs. 6-7)")
+    bd.add_argument("--method", default="tseng", choices=sorted(m for m in METHODS if METHODS[m].is_sensor_frame))
+    bd.add_argument("--out", help="PNG to write (default bode_METHOD.png)")
+
     bn = sub.add_parser("bench", help="samples per second of the batch estimator, vqf and ahrs Madgwick")
     bn.add_argument("--json", action="store_true")
     bn.add_argument("--samples", type=int, default=100_000)
@@ -128,15 +136,45 @@ def cmd_verify(args) -> int:
     if args.json:
         print(json.dumps({"rows": rows}, indent=2))
     else:
-        print(f"{'profile':>10} {'method':>12} {'rms °':>8} {'max °':>8} {'mean °':>9}  {'bound °':>8} {'on':>4}  result")
+        print(f"{'profile':>15} {'method':>14} {'rms °':>8} {'max °':>8} {'mean °':>9}  {'bound °':>8} {'on':>4}  result")
         for r in rows:
-            print(f"{r['profile']:>10} {r['method']:>12} {r['rms_deg']:8.3f} {r['max_deg']:8.3f} {r['mean_deg']:9.5f}"
-                  f"  {r['bound_deg']:8.3f} {r['metric']:>4}  {'pass' if r['pass'] else 'FAIL'}")
+            bound = "       —" if r["bound_deg"] is None else f"{r['bound_deg']:8.3f}"
+            result = "report" if r["bound_deg"] is None else "pass" if r["pass"] else "FAIL"
+            print(f"{r['profile']:>15} {r['method']:>14} {r['rms_deg']:8.3f} {r['max_deg']:8.3f} {r['mean_deg']:9.5f}"
+                  f"  {bound} {r['metric']:>4}  {result}")
         print("profiles: " + "; ".join(f"{n}: {PROFILES[n].summary}" for n in dict.fromkeys(r["profile"] for r in rows)))
     failed = [r for r in rows if not r["pass"]]
     if failed:
         print(f"attitude: {len(failed)} of {len(rows)} rows missed their bound", file=sys.stderr)
         return EXIT_CHECK_FAILED
+    return 0
+
+
+def cmd_compare(args) -> int:
+    from .compare import compare
+    from .motion import PROFILES
+
+    for name in args.profile or []:
+        if name not in PROFILES:
+            raise ValueError(f"unknown profile {name!r}; available: {', '.join(PROFILES)}")
+    result = compare(args.profile)
+    if args.json:
+        print(json.dumps(result, indent=2))
+        return 0
+    print("inclination error, degrees: RMS / max / mean (bias); realistic MEMS noise, default parameters")
+    for profile, rows in result["profiles"].items():
+        print(f"\n{profile}")
+        for method, r in rows.items():
+            print(f"  {method:>15} {r['rms_deg']:8.3f} {r['max_deg']:8.3f} {r['mean_deg']:9.4f}")
+    return 0
+
+
+def cmd_bode(args) -> int:
+    from .bode import plot
+
+    out = args.out or f"bode_{args.method}.png"
+    plot(args.method, out)
+    print(f"attitude: wrote {out}", file=sys.stderr)
     return 0
 
 
@@ -170,7 +208,8 @@ def cmd_bench(args) -> int:
 
 def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
-    handler = {"estimate": cmd_estimate, "table1": cmd_table1, "verify": cmd_verify, "bench": cmd_bench}[args.command]
+    handler = {"estimate": cmd_estimate, "table1": cmd_table1, "verify": cmd_verify, "compare": cmd_compare,
+               "bode": cmd_bode, "bench": cmd_bench}[args.command]
     try:
         return handler(args)
     except (ValueError, OSError, RuntimeError) as exc:

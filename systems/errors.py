@@ -28,3 +28,16 @@ def bias_angle(up_est, quat_true) -> float:
 
 def rms(x) -> float:
     return float(np.sqrt(np.mean(np.square(x))))
+
+
+def quaternion_errors(quat_est, quat_ref):
+    """Total, heading and inclination error (rad) per sample, as BROAD defines them:
+    q_err = q_est ⊗ q_ref⁻¹ (earth frame); total 2·acos|w|, heading 2·atan|z/w|,
+    inclination 2·acos√(w² + z²)."""
+    err = (Rotation.from_quat(quat_est, scalar_first=True)
+           * Rotation.from_quat(quat_ref, scalar_first=True).inv()).as_quat(scalar_first=True)
+    w, z = np.abs(err[:, 0]), err[:, 3]
+    total = 2 * np.arccos(np.clip(w, 0.0, 1.0))
+    heading = 2 * np.arctan2(np.abs(z), w)
+    inclination = 2 * np.arccos(np.clip(np.sqrt(w * w + z * z), 0.0, 1.0))
+    return total, heading, inclination

@@ -13,6 +13,7 @@ from scipy import signal
 from blocks import accuracy
 from blocks import earth_filters as ef
 from blocks.methods import method as get_method
+from blocks.sensor_frame import DiscreteFilter
 
 from .batch import AttitudeEstimate, estimate
 from .errors import bias_angle, earth_frame_error, inclination_error, rms
@@ -144,7 +145,7 @@ def lever_arm_bias(rate: float = 2.0, radius: float = 0.2, duration: float = 600
     filt = get_method("wiener").filter(params)
     start = int(settle_time(filt) * fs)
     est = estimate(motion.gyr, motion.acc, fs, "wiener", params)
-    lowpass = _sensor_lowpass(filt, motion.acc, fs)
+    lowpass = _lti_filter(filt, motion.acc, fs)  # the raw accelerometer in sensor coordinates
     # eq. 19: the mean sensor-frame acceleration is the mean centripetal ω × v
     mean_acc = motion.acc[start:].mean(axis=0) - g * motion.up[start:].mean(axis=0)
     up = motion.up[start]  # constant in sensor coordinates for this motion
@@ -186,16 +187,5 @@ def _pitch(vectors) -> np.ndarray:
 
 
 def _lti_filter(filt, x, fs: float) -> np.ndarray:
-    """Apply the earth-frame filter (ZOH form) to the columns of x, starting at rest on x[0]."""
-    disc = control.c2d(control.ss(filt), 1.0 / fs, method="zoh")
-    b, a = signal.ss2tf(disc.A, disc.B, disc.C, disc.D)
-    x = np.asarray(x, dtype=float)
-    zi = signal.lfilter_zi(b[0], a) * x[0:1].T if x.ndim == 2 else signal.lfilter_zi(b[0], a) * x[0]
-    if x.ndim == 2:
-        return np.column_stack([signal.lfilter(b[0], a, x[:, i], zi=zi[i])[0] for i in range(x.shape[1])])
-    return signal.lfilter(b[0], a, x, zi=zi)[0]
-
-
-def _sensor_lowpass(filt, acc, fs: float) -> np.ndarray:
-    """The same filter on the raw accelerometer in sensor coordinates (no rotation)."""
-    return _lti_filter(filt, acc, fs)
+    """The earth-frame filter (ZOH form) on the columns of x, without rotation, at rest on x[0]."""
+    return DiscreteFilter.from_lti(filt, 1.0 / fs).apply(x)

@@ -240,6 +240,84 @@ def incline_oscillation(incline_deg: float = 45.0, peak_acc_g: float = math.sqrt
     )
 
 
+def _rot(axis: str, angle) -> Rotation:
+    """Rotation about a coordinate axis by angle (rad, scalar or array)."""
+    angle = np.atleast_1d(np.asarray(angle, dtype=float))
+    vectors = np.zeros((len(angle), 3))
+    vectors[:, "xyz".index(axis)] = angle
+    return Rotation.from_rotvec(vectors)
+
+
+def _at_rest(t):
+    return np.zeros((len(np.atleast_1d(t)), 3))
+
+
+def coning(theta: float = 1.0, rate: float = 1.0, g: float = STANDARD_GRAVITY) -> ClosedFormMotion:
+    """Luinge's coning motion with half-angle theta (rad) at rate (rad/s), fixed in position:
+    R(t) = Rz(rate·t)·Rx(theta)·Rz(−rate·t) (NOTES §3; the paper's ω has a typo)."""
+    return ClosedFormMotion(
+        "coning", lambda t: _rot("z", rate * t) * _rot("x", np.full(len(np.atleast_1d(t)), theta)) * _rot("z", -rate * t),
+        _at_rest, g)
+
+
+def sine_rotation(amplitude_deg: float = 10.0, frequency: float = 0.5, inclination_deg: float = 0.0,
+                  g: float = STANDARD_GRAVITY) -> ClosedFormMotion:
+    """Tseng experiments 1–2: ±amplitude_deg pitch (about the platform's y axis) at
+    frequency (Hz); the IMU inclined by inclination_deg about the platform's x axis."""
+    amp, w, incl = math.radians(amplitude_deg), 2 * math.pi * frequency, math.radians(inclination_deg)
+    return ClosedFormMotion(
+        "sine_rotation", lambda t: _rot("y", amp * np.sin(w * t)) * _rot("x", np.full(len(np.atleast_1d(t)), incl)),
+        _at_rest, g)
+
+
+STEP_SIZES_DEG = (5.0, 10.0, 20.0, 45.0, 90.0)
+
+
+def step_rotation(hold: float = 10.0, ramp: float = 0.2, g: float = STANDARD_GRAVITY) -> ClosedFormMotion:
+    """Tseng experiment 3: pitch steps of STEP_SIZES_DEG, each held hold (s) and back to 0
+    for hold (s); each step a raised-cosine ramp of ramp (s). Repeats after the last."""
+    levels = np.array([x for size in STEP_SIZES_DEG for x in (size, 0.0)])
+    radians = np.radians(levels)
+
+    def pitch(t):
+        t = np.asarray(t, dtype=float)
+        i = np.floor(t / hold).astype(int)
+        into = t - i * hold
+        now, before = radians[i % len(levels)], radians[(i - 1) % len(levels)]
+        blend = np.where(into < ramp, 0.5 - 0.5 * np.cos(np.pi * np.clip(into / ramp, 0, 1)), 1.0)
+        return np.where(t < hold, now * blend, before + (now - before) * blend)
+
+    return ClosedFormMotion("step_rotation", lambda t: _rot("y", pitch(np.atleast_1d(t))), _at_rest, g)
+
+
+def linear_motion(amplitude: float = 0.5, period: float = 4.0, mount_x_deg: float = 0.0, mount_y_deg: float = 0.0,
+                  mount_z_deg: float = 0.0, g: float = STANDARD_GRAVITY) -> ClosedFormMotion:
+    """Tseng experiment 4: back and forth along the earth x axis, x(t) = amplitude·(1 −
+    cos 2πt/period)/2 (m), the IMU mounted rotated by mount_x/y/z_deg about X, Y, Z."""
+    mount = Rotation.from_euler("XYZ", [mount_x_deg, mount_y_deg, mount_z_deg], degrees=True)
+    w = 2 * math.pi / period
+    return ClosedFormMotion(
+        "linear_motion", lambda t: Rotation.from_quat(np.tile(mount.as_quat(), (len(np.atleast_1d(t)), 1))),
+        lambda t: np.outer(amplitude * w / 2 * np.sin(w * np.atleast_1d(t)), [1.0, 0.0, 0.0]), g)
+
+
+def offset_rotation(frequency: float = 0.4, amplitude_deg: float = 45.0, radius: float = 0.2,
+                    inclination_deg: float = 0.0, pitch_deg: float = 0.0, g: float = STANDARD_GRAVITY) -> ClosedFormMotion:
+    """Tseng experiment 5: yaw ψ = amplitude_deg·sin(2π·frequency·t) on an arm of radius (m),
+    so centripetal and tangential acceleration; the IMU mounted with inclination_deg about
+    x and pitch_deg about y. R(t) = Rz(ψ)·R_mount, position radius·(cos ψ, sin ψ, 0)."""
+    amp, w = math.radians(amplitude_deg), 2 * math.pi * frequency
+    mount = Rotation.from_euler("xy", [inclination_deg, pitch_deg], degrees=True)
+
+    def velocity(t):
+        t = np.atleast_1d(t)
+        psi, psi_dot = amp * np.sin(w * t), amp * w * np.cos(w * t)
+        return radius * np.column_stack([-np.sin(psi) * psi_dot, np.cos(psi) * psi_dot, np.zeros_like(t)])
+
+    return ClosedFormMotion("offset_rotation", lambda t: _rot("z", amp * np.sin(w * np.atleast_1d(t))) * mount,
+                            velocity, g)
+
+
 @dataclass(frozen=True)
 class Profile:
     """A named motion with documented parameters (blocks.methods.Param)."""
@@ -279,6 +357,33 @@ def _profiles() -> dict:
             Param("incline_deg", 45.0, "deg", "slope of the incline"),
             Param("peak_acc_g", math.sqrt(2.0), "1", "peak acceleration in units of g"),
             Param("frequency", 1.0, "Hz", "frequency of the oscillation"),
+        )),
+        Profile("coning", "Luinge's coning motion, theta = rate = 1", coning, (
+            Param("theta", 1.0, "rad", "half-angle of the cone"),
+            Param("rate", 1.0, "rad/s", "coning rate"),
+        )),
+        Profile("sine_rotation", "Tseng 1-2: ±10° sinusoidal pitch, optionally inclined", sine_rotation, (
+            Param("amplitude_deg", 10.0, "deg", "pitch amplitude"),
+            Param("frequency", 0.5, "Hz", "pitch frequency"),
+            Param("inclination_deg", 0.0, "deg", "IMU inclination about x (Tseng 2: 20)", True),
+        )),
+        Profile("step_rotation", "Tseng 3: pitch steps of 5, 10, 20, 45, 90°", step_rotation, (
+            Param("hold", 10.0, "s", "time each level is held"),
+            Param("ramp", 0.2, "s", "duration of each raised-cosine step"),
+        )),
+        Profile("linear_motion", "Tseng 4: back and forth along a line, IMU mounted at an angle", linear_motion, (
+            Param("amplitude", 0.5, "m", "travel"),
+            Param("period", 4.0, "s", "period of the back-and-forth"),
+            Param("mount_x_deg", 0.0, "deg", "mounting rotation about X", True),
+            Param("mount_y_deg", 0.0, "deg", "mounting rotation about Y", True),
+            Param("mount_z_deg", 0.0, "deg", "mounting rotation about Z", True),
+        )),
+        Profile("offset_rotation", "Tseng 5: 0.4 Hz yaw oscillation on a 20 cm arm", offset_rotation, (
+            Param("frequency", 0.4, "Hz", "yaw frequency"),
+            Param("amplitude_deg", 45.0, "deg", "yaw amplitude"),
+            Param("radius", 0.2, "m", "arm length"),
+            Param("inclination_deg", 0.0, "deg", "IMU inclination about x", True),
+            Param("pitch_deg", 0.0, "deg", "IMU pitch about y", True),
         )),
     )}
 

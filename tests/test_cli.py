@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 from scipy.io import savemat
 
+from blocks.methods import METHODS
 from systems.batch import estimate
 from systems.cli import main
 from systems.motion import HumanMotion
@@ -131,3 +132,12 @@ def test_bench_json_reports_rates_and_ratios(capsys):
     assert set(result["samples_per_s"]) == {"wiener", "vqf", "madgwick"}
     assert result["ratio_vs_vqf"]["vqf"] == pytest.approx(1.0)
     assert all(rate > 0 for rate in result["samples_per_s"].values())
+
+
+@pytest.mark.parametrize("method", sorted(METHODS))
+def test_estimate_runs_every_method_as_the_batch_path_does(tmp_path, imu, method):
+    gyr, acc = imu
+    _write_csv(tmp_path / "in.csv", _imu_columns(gyr, acc))
+    assert main(["estimate", str(tmp_path / "in.csv"), "--out", str(tmp_path / "out.csv"), "--method", method]) == 0
+    ref = estimate(gyr, acc, FS, method)
+    assert np.abs(_read_output(tmp_path / "out.csv")[1][:, 1:5] - ref.quat).max() < 1e-9

@@ -1,0 +1,147 @@
+"""The seed estimators of Luinge and Tseng, Mahony's filter, and the papers' experiments."""
+import json
+import math
+import warnings
+
+import control
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from blocks import tseng
+from blocks.methods import METHODS, estimator_system, stepper
+from systems.batch import estimate
+from systems.cli import main
+from systems.compare import IMU, compare_profile
+from systems.errors import inclination_error, quaternion_errors, rms
+from systems.motion import PROFILES, profile
+from systems.sensor_model import ImuModel
+
+FS = 100.0
+HZ = np.logspace(-2, 1, 400)  # 0.01 … 10 Hz
+
+
+@pytest.mark.parametrize("name", sorted(METHODS))
+def test_block_and_batch_path_run_the_same_step_for_every_method(name):
+    rng = np.random.default_rng(4)
+    gyr = rng.normal(0, 1.5, (300, 3))
+    acc = rng.normal(0, 2.0, (300, 3)) + [0, 0, 9.81]
+    step = stepper(name, (), 1 / FS)
+    resp = control.input_output_response(estimator_system(name, dt=1 / FS), np.arange(300) / FS,
+                                         np.hstack([gyr, acc]).T, X0=step.initial_state(acc[0]))
+    batch = estimate(gyr, acc, FS, name)
+    assert np.abs(resp.outputs.T - np.hstack([batch.gravity, batch.quat])).max() <= 1e-12
+
+
+def _gyro_integration(gyr, q0):
+    """Orientation from the gyro alone (the thin line of Luinge's Fig. 5)."""
+    rotations = Rotation.from_rotvec(gyr / FS)
+    out, current = np.empty((len(gyr), 4)), Rotation.from_quat(q0, scalar_first=True)
+    for k in range(len(gyr)):
+        current = current * rotations[k]
+        out[k] = current.as_quat(scalar_first=True)
+    return out
+
+
+def test_luinge_fig5_on_coning():
+    """θ = Ω = 1; gyro noise s.d. 1 rad/s per sample at 100 Hz; accelerometer = gravity, then
+    gravity plus 1 m/s² along [1 1 1] in sensor coordinates."""
+    motion = profile("coning").motion().generate(60.0, FS)
+    q0 = profile("coning").motion().orientation(np.array([0.0])).as_quat(scalar_first=True)[0]
+    delta_n = 1.0 / math.sqrt(FS / 2)  # s.d. 1 rad/s per sample
+    t = np.arange(1, len(motion.gyr) + 1) / FS
+    later = t > 5.0
+    results = {}
+    for offset in (0.0, 1.0):
+        imu = ImuModel(delta_n=delta_n, acc_offset=tuple(np.full(3, offset / math.sqrt(3))))
+        gyr, acc = imu.apply(motion, seed=5)
+        filt = quaternion_errors(estimate(gyr, acc, FS, "luinge", {"delta_n": delta_n}).quat, motion.quat)
+        integ = quaternion_errors(_gyro_integration(gyr, q0), motion.quat)
+        results[offset] = (filt, integ)
+        # after the first seconds the filter's error stays below the gyro integration's
+        assert rms(filt[0][later]) < 0.7 * rms(integ[0][later])
+        # the heading part still walks: it dominates and grows, uncorrected
+        assert rms(filt[1][later]) > 3 * rms(filt[2][later])
+        assert rms(filt[1][t > 40]) > 2 * rms(filt[1][t <= 5])
+    # the constant offset makes the (inclination) error larger
+    assert rms(results[1.0][0][2][later]) > rms(results[0.0][0][2][later]) + math.radians(2.0)
+
+
+def test_tseng_chain_is_within_1_db_of_unity_from_001_to_10_hz():
+    w = 2j * np.pi * HZ
+    for pair in ("acc", "mag"):
+        uncompensated = np.abs(20 * np.log10(np.abs(tseng.chain(pair)(w)))).max()
+        compensated = np.abs(20 * np.log10(np.abs(tseng.compensated_chain(pair)(w)))).max()
+        assert uncompensated > 1.0  # Figs. 6-7: the residual the compensation removes
+        assert compensated < 1.0
+    # the compensation is stable (every zero of both chains in the left half-plane)
+    for pair in ("acc", "mag"):
+        assert np.all(np.real(control.poles(tseng.compensation(pair))) < 0)
+    # the `tseng` method's earth filter is C·G_LA, and G_A's realisation is G_A up to 10 Hz
+    assert np.allclose(METHODS["tseng"].filter()(w), (tseng.compensation("acc") * tseng.lowpass_acc())(w), rtol=1e-9)
+    ratio = tseng.accelerometer_model()(w) / tseng.accelerometer()(w)
+    assert np.abs(20 * np.log10(np.abs(ratio))).max() < 0.05  # 0.034 dB at 10 Hz
+
+
+def test_euler_angles_from_gravity_and_field_match_scipy():
+    rot = Rotation.random(50, random_state=3)
+    roll, pitch, yaw = tseng.euler_from_gravity_mag(rot.inv().apply([0, 0, 1]), rot.inv().apply([0, 20, -45]))
+    expected = rot.as_euler("ZYX")
+    assert np.allclose(np.column_stack([yaw, pitch, roll]), expected, atol=1e-12)
+
+
+def test_tseng4_mounting_at_90_deg():
+    """An Euler-angle estimator hits the singularity of Tseng's Tables III/V at 90° about Y;
+    every project estimator's inclination error at 90° stays within 0.2° of that at 0°."""
+    errors = {}
+    for axis in "xyz":
+        for mount in (0.0, 90.0):
+            motion = profile("linear_motion").motion({f"mount_{axis}_deg": mount}).generate(120.0, FS)
+            gyr, acc = IMU.apply(motion, 1)
+            kept = slice(2000, None)
+            errors[axis, mount] = {m: rms(np.degrees(inclination_error(estimate(gyr, acc, FS, m).up[kept],
+                                                                       motion.up[kept]))) for m in METHODS}
+            roll, _ = tseng.euler_complementary(gyr, acc, FS)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")  # scipy warns of the gimbal lock it resolves with roll = 0
+                true_roll = Rotation.from_quat(motion.quat, scalar_first=True).as_euler("ZYX")[:, 2]
+            errors[axis, mount]["euler_roll"] = rms(np.degrees(np.angle(np.exp(1j * (roll - true_roll))))[kept])
+    assert errors["y", 90.0]["euler_roll"] > 5.0
+    assert errors["y", 90.0]["euler_roll"] > 100 * errors["y", 0.0]["euler_roll"]
+    for axis in "xyz":
+        for m in METHODS:
+            assert abs(errors[axis, 90.0][m] - errors[axis, 0.0][m]) < 0.2, (axis, m)
+
+
+def test_offset_rotation_leaves_the_wiener_estimator_unbiased():
+    """Tseng 5 / Rizun §2.4: 0.4 Hz yaw on a 20 cm arm."""
+    table = compare_profile("offset_rotation", peers=())
+    assert table["wiener"]["mean_deg"] < 0.05
+    # Mahony's bias estimate integrates the centripetal term in sensor coordinates
+    assert table["mahony"]["mean_deg"] > 10 * table["wiener"]["mean_deg"]
+
+
+def test_profiles_have_exact_truth():
+    for name, prof in PROFILES.items():
+        motion = prof.motion().generate(30.0, FS, seed=2)
+        rot = Rotation.from_quat(motion.quat, scalar_first=True)
+        assert np.abs((rot[:-1].inv() * rot[1:]).as_rotvec() - motion.gyr[1:] / FS).max() < 1e-12, name
+
+
+def test_compare_json_contract_and_peers_agree_on_an_easy_profile(capsys):
+    assert main(["compare", "--json", "--profile", "sine_rotation"]) == 0
+    table = json.loads(capsys.readouterr().out)["profiles"]["sine_rotation"]
+    assert set(table) == set(METHODS) | {"vqf", "madgwick"}
+    for row in table.values():
+        assert set(row) == {"rms_deg", "max_deg", "mean_deg"}
+    # conventions: every estimator, peers included, follows a ±10° pitch within a degree
+    assert max(row["rms_deg"] for row in table.values()) < 1.0
+
+
+def test_bode_writes_a_png(tmp_path):
+    out = tmp_path / "tseng.png"
+    assert main(["bode", "--method", "tseng", "--out", str(out)]) == 0
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    with pytest.raises(SystemExit) as refused:  # argparse: not an LTI filter
+        main(["bode", "--method", "luinge", "--out", str(out)])
+    assert refused.value.code == 2
