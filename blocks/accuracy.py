@@ -96,3 +96,30 @@ def mean_square_error(
         value, _ = integrate.quad(integrand, lo, hi, limit=400)
         total += value
     return 2.0 * total / (2.0 * math.pi)
+
+
+def smoother_mean_square_gravity_error(delta_n: float, delta_v: float, a: float = 1.0,
+                                       g: float = STANDARD_GRAVITY) -> float:
+    """⟨Δg²⟩ per component of the offline smoother (eq. 34 forward, then backward).
+
+    Forward–backward, the Butterworth's response is |H|² = ω_g⁴/(ω_g⁴ + ω⁴), the
+    non-causal Wiener filter S_g/(S_g + S_a) of eqs. 16 and 20. Eq. 41 then gives
+    S_Δg = (δv²ω_g⁴/2)·ω²(ω⁴ + a²ω_g⁴)/(ω_g⁴ + ω⁴)², and with ∫x²/(1+x⁴)² = π/(4√2),
+    ∫x⁶/(1+x⁴)² = 3π/(4√2): ⟨Δg²⟩ = (3 + a²)/(16√2)·g·δn·δv·ω_g, a quarter of eq. 49.
+    """
+    return mean_square_gravity_error(delta_n, delta_v, a, g) / 4.0
+
+
+def smoother_rms_attitude_error(delta_n: float, delta_v: float, a: float = 1.0,
+                                g: float = STANDARD_GRAVITY) -> float:
+    """RMS attitude error (rad) of the offline smoother: half of eq. 50."""
+    return math.sqrt(2.0 * smoother_mean_square_gravity_error(delta_n, delta_v, a, g) / g**2)
+
+
+def smoother_error_spectrum(filt: control.TransferFunction, omega, delta_n: float, delta_v: float,
+                            omega_c: float | None = None, g: float = STANDARD_GRAVITY):
+    """Eq. 41 for a filter applied forward and backward (zero phase, response |H|²)."""
+    omega = np.asarray(omega, dtype=float)
+    response = np.abs(np.asarray(filt(1j * omega))) ** 2
+    return ((1.0 - response) ** 2 * gravity_signal_spectrum(omega, delta_n, g)
+            + response**2 * acceleration_spectrum(omega, delta_v, omega_c))

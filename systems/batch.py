@@ -7,7 +7,10 @@ from typing import Mapping
 
 import numpy as np
 
-from blocks.methods import stepper
+from scipy.spatial.transform import Rotation
+
+from blocks.gyro_offset import correct as correct_gyro
+from blocks.methods import METHODS, method as get_method, stepper
 
 
 @dataclass
@@ -20,6 +23,7 @@ class AttitudeEstimate:
 
     gravity: np.ndarray
     quat: np.ndarray
+    offset: np.ndarray | None = None  # N×3 gyro-offset estimate, rad/s, when one was made
 
     @property
     def up(self) -> np.ndarray:
@@ -48,18 +52,52 @@ def check_imu(gyr, acc, fs: float) -> tuple[np.ndarray, np.ndarray]:
 
 def estimate(
     gyr, acc, fs: float, method: str = "wiener", params: Mapping[str, float] | None = None,
-    initial_gravity=None,
+    initial_gravity=None, offline: bool = False, gyro_offset: bool = False,
 ) -> AttitudeEstimate:
     """Estimate attitude over a recording: gyr N×3 rad/s, acc N×3 m/s², fs in Hz.
 
     params are the method's documented parameters (see blocks.methods), defaults
     otherwise. The filter starts at rest on initial_gravity (m/s², sensor coordinates),
-    by default the first accelerometer sample.
+    by default the first accelerometer sample. offline: the method's earth-frame filter
+    forward, then backward over the forward estimate (for `wiener` the non-causal Wiener
+    smoother, see blocks.accuracy.smoother_mean_square_gravity_error). gyro_offset: first
+    estimate the gyro offset at rest and remove it (blocks.gyro_offset; the estimate is
+    returned as `offset`).
     """
     gyr, acc = check_imu(gyr, acc, fs)
+    offset = None
+    if gyro_offset:
+        gyr, offset = correct_gyro(gyr, acc, fs)
     step = stepper(method, tuple(sorted((params or {}).items())), 1.0 / fs)
-    state = step.initial_state(acc[0] if initial_gravity is None else initial_gravity)
+    forward = _run(step, gyr, acc, acc[0] if initial_gravity is None else initial_gravity)
+    forward.offset = offset
+    if not offline:
+        return forward
+    if not get_method(method).is_sensor_frame:
+        raise ValueError(f"offline smoothing needs an earth-frame filter method "
+                         f"({', '.join(n for n, m in METHODS.items() if m.is_sensor_frame)}), not {method!r}")
+    # backward in time: the step from sample k+1 to k turns the frame back by gyr[k+1]
+    gyr_back = np.vstack([np.zeros((1, 3)), -gyr[:0:-1]])
+    backward = _run(step, gyr_back, np.ascontiguousarray(forward.gravity[::-1]), forward.gravity[-1])
+    gravity = backward.gravity[::-1].copy()
+    return AttitudeEstimate(gravity, level_onto(forward.quat, gravity), offset)
+
+
+def _run(step, gyr, acc, initial_gravity) -> AttitudeEstimate:
+    state = step.initial_state(initial_gravity)
     gravity = np.empty_like(acc)
     quat = np.empty((acc.shape[0], 4))
     step.run(state, gyr, acc, gravity, quat)
     return AttitudeEstimate(gravity, quat)
+
+
+def level_onto(quat, gravity) -> np.ndarray:
+    """Orientations (N×4) turned by the smallest earth-frame rotation that takes each
+    estimated up (gravity, sensor coordinates) onto earth up; heading is kept."""
+    rot = Rotation.from_quat(quat, scalar_first=True)
+    up = rot.apply(gravity / np.linalg.norm(gravity, axis=1, keepdims=True))
+    horizontal = np.hypot(up[:, 0], up[:, 1])
+    angle = np.arctan2(horizontal, up[:, 2])
+    scale = np.divide(angle, horizontal, out=np.zeros_like(angle), where=horizontal > 0)
+    correction = Rotation.from_rotvec(np.column_stack([up[:, 1] * scale, -up[:, 0] * scale, np.zeros_like(angle)]))
+    return (correction * rot).as_quat(scalar_first=True)

@@ -1,4 +1,4 @@
-"""The `attitude` command line: estimate, table1, verify, compare, bode, bench."""
+"""The `attitude` command line: estimate, evaluate, table1, verify, compare, bode, bench."""
 from __future__ import annotations
 
 import argparse
@@ -33,6 +33,13 @@ def _method_help() -> str:
     return "\n".join(lines)
 
 
+def _add_real_data_flags(parser) -> None:
+    parser.add_argument("--offline", action="store_true",
+                        help="forward-backward smoothing of the earth-frame filter (wiener: the Wiener smoother)")
+    parser.add_argument("--gyro-offset", default="on", choices=["on", "off"],
+                        help="estimate and remove the gyro offset at rest (default on)")
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="attitude", description="IMU attitude estimators (Rizun's optimal Wiener filter and peers).",
@@ -51,6 +58,14 @@ def build_parser() -> argparse.ArgumentParser:
                      help="method parameter in the unit listed below; repeatable")
     est.add_argument("--gyr-unit", default="rad/s", choices=["rad/s", "deg/s"])
     est.add_argument("--acc-unit", default="m/s2", choices=["m/s2", "g"])
+    _add_real_data_flags(est)
+
+    ev = sub.add_parser("evaluate", help="errors against an optical reference (BROAD .mat), beside vqf and madgwick")
+    ev.add_argument("files", nargs="+", metavar="FILE")
+    ev.add_argument("--method", default="wiener", choices=sorted(METHODS))
+    ev.add_argument("--param", type=_param, action="append", default=[], metavar="NAME=VALUE")
+    ev.add_argument("--json", action="store_true")
+    _add_real_data_flags(ev)
 
     t1 = sub.add_parser("table1", help="Rizun's Table 1: analytic (eq. 50) and simulated RMS attitude error")
     t1.add_argument("--json", action="store_true", help="print JSON instead of a table")
@@ -87,9 +102,33 @@ def cmd_estimate(args) -> int:
     from .recording import read_recording, write_estimate
 
     rec = read_recording(args.input, fs=args.fs, gyr_unit=args.gyr_unit, acc_unit=args.acc_unit)
-    result = estimate(rec.gyr, rec.acc, rec.fs, args.method, dict(args.param))
+    result = estimate(rec.gyr, rec.acc, rec.fs, args.method, dict(args.param), offline=args.offline,
+                      gyro_offset=args.gyro_offset == "on")
     write_estimate(args.out, rec.t, result.quat, result.up)
     print(f"attitude: {len(rec.gyr)} samples at {rec.fs:g} Hz, method {args.method} → {args.out}", file=sys.stderr)
+    return 0
+
+
+def cmd_evaluate(args) -> int:
+    from .evaluate import METRICS, evaluate
+
+    try:
+        import vqf  # noqa: F401
+        import ahrs  # noqa: F401
+    except ImportError as exc:
+        raise RuntimeError(f"attitude evaluate compares with vqf and ahrs ({exc}); "
+                           "install them with: pip install 'attitude-fmu[peers]'") from None
+    result = evaluate(args.files, args.method, dict(args.param), args.offline, args.gyro_offset == "on")
+    if args.json:
+        print(json.dumps(result, indent=2))
+        return 0
+    labels = list(result["mean"])
+    print("RMSE over the movement phase, degrees: inclination / heading / total")
+    print(f"{'recording':>45} " + " ".join(f"{label:>22}" for label in labels))
+    rows = list(result["recordings"].items()) + [("mean", result["mean"])]
+    for name, table in rows:
+        cells = " ".join(f"{'/'.join(format(table[l][m], '.2f') for m in reversed(METRICS)):>22}" for l in labels)
+        print(f"{name:>45} {cells}")
     return 0
 
 
@@ -208,7 +247,7 @@ def cmd_bench(args) -> int:
 
 def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
-    handler = {"estimate": cmd_estimate, "table1": cmd_table1, "verify": cmd_verify, "compare": cmd_compare,
+    handler = {"estimate": cmd_estimate, "evaluate": cmd_evaluate, "table1": cmd_table1, "verify": cmd_verify, "compare": cmd_compare,
                "bode": cmd_bode, "bench": cmd_bench}[args.command]
     try:
         return handler(args)

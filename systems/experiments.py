@@ -33,15 +33,20 @@ class HumanRun:
     est: AttitudeEstimate
     start: int  # first sample kept
     g: float
+    stop: int | None = None  # one past the last sample kept (None: to the end)
+
+    @property
+    def kept(self) -> slice:
+        return slice(self.start, self.stop)
 
     @property
     def errors(self) -> np.ndarray:
         """Inclination error per kept sample, rad."""
-        return inclination_error(self.est.gravity[self.start:], self.motion.up[self.start:])
+        return inclination_error(self.est.gravity[self.kept], self.motion.up[self.kept])
 
     def earth_error(self) -> np.ndarray:
         """Kept gravity-estimate error in true earth coordinates, N×3, m/s²."""
-        return earth_frame_error(self.est.gravity[self.start:], self.motion.quat[self.start:], self.g)
+        return earth_frame_error(self.est.gravity[self.kept], self.motion.quat[self.kept], self.g)
 
 
 def settle_time(earth_filter) -> float:
@@ -52,20 +57,20 @@ def settle_time(earth_filter) -> float:
 def simulate_human(delta_n: float, delta_v: float, a: float = 1.0, method: str = "wiener",
                    params: dict | None = None, duration: float = 20000.0, fs: float = 100.0,
                    seed: int = 0, omega_c: float = 10.0, g: float = PAPER_G,
-                   rot_rms: float = 1.0) -> HumanRun:
+                   rot_rms: float = 1.0, offline: bool = False) -> HumanRun:
     """Run an estimator designed for (delta_n, delta_v) on human motion of slosh a·delta_v.
 
     delta_n in rad/s/√Hz, delta_v in m/s/√Hz, durations in s, fs in Hz, rot_rms (RMS
-    angular rate per axis) in rad/s.
+    angular rate per axis) in rad/s; offline: the forward–backward smoother, both ends cut.
     """
     design = {"delta_n": delta_n, "delta_v": delta_v, "g": g, **(params or {})}
     motion = HumanMotion(delta_v=a * delta_v, omega_c=omega_c, rot_rms=rot_rms, g=g).generate(duration, fs, seed)
     gyr, acc = ImuModel(delta_n=delta_n).apply(motion, seed=seed + 1)
-    est = estimate(gyr, acc, fs, method, design)
+    est = estimate(gyr, acc, fs, method, design, offline=offline)
     start = int(settle_time(get_method(method).filter(design)) * fs)
-    if start >= len(acc) // 2:
+    if start >= len(acc) // 3:
         raise ValueError(f"duration {duration} s is too short for the filter to settle")
-    return HumanRun(motion, est, start, g)
+    return HumanRun(motion, est, start, g, len(acc) - start if offline else None)
 
 
 def table1(duration: float = 20000.0, fs: float = 100.0, seed: int = 0, rows=TABLE1_ROWS,

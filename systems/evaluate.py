@@ -1,0 +1,63 @@
+"""`attitude evaluate`: recordings with an optical reference (BROAD), errors as the
+dataset defines them, for a project method and, on the same samples, vqf online and
+offline and ahrs' Madgwick."""
+from __future__ import annotations
+
+import math
+import sys
+
+import numpy as np
+
+from .batch import estimate
+from .compare import peer_quaternions
+from .errors import quaternion_errors
+from .recording import Recording, RecordingError, read_recording
+
+METRICS = ("total_rmse_deg", "heading_rmse_deg", "inclination_rmse_deg")
+
+
+def errors_on_movement(quat, rec: Recording) -> dict:
+    """RMSE (deg) of total, heading and inclination error where `movement` is set and the
+    reference is finite (BROAD's definitions; see systems.errors.quaternion_errors)."""
+    ok = rec.movement & np.isfinite(rec.quat_ref).all(axis=1)
+    errors = quaternion_errors(quat[ok], rec.quat_ref[ok])
+    return {name: math.degrees(float(np.sqrt(np.mean(e**2)))) for name, e in zip(METRICS, errors)}
+
+
+def evaluate_recording(rec: Recording, method: str = "wiener", params=None, offline: bool = False,
+                       gyro_offset: bool = True) -> dict:
+    """{method label: {metric: value}} for one recording."""
+    if rec.quat_ref is None or rec.movement is None:
+        raise RecordingError(f"{rec.name}: no optical reference (opt_quat and movement); cannot evaluate")
+    if not (rec.movement & np.isfinite(rec.quat_ref).all(axis=1)).any():
+        raise RecordingError(f"{rec.name}: the reference has no valid sample during movement")
+    import vqf as vqf_module  # peers: the test extra (or [peers])
+
+    label = f"{method}_offline" if offline else method
+    est = estimate(rec.gyr, rec.acc, rec.fs, method, params, offline=offline, gyro_offset=gyro_offset)
+    gyr, acc = np.ascontiguousarray(rec.gyr), np.ascontiguousarray(rec.acc)
+    return {
+        label: errors_on_movement(est.quat, rec),
+        "vqf": errors_on_movement(peer_quaternions("vqf", gyr, acc, rec.fs), rec),
+        "vqf_offline": errors_on_movement(vqf_module.offlineVQF(gyr, acc, None, 1.0 / rec.fs)["quat6D"], rec),
+        "madgwick": errors_on_movement(peer_quaternions("madgwick", gyr, acc, rec.fs), rec),
+    }
+
+
+def evaluate(paths, method: str = "wiener", params=None, offline: bool = False, gyro_offset: bool = True,
+             progress: bool = True) -> dict:
+    """{"recordings": {name: {label: metrics}}, "mean": {label: metrics}} over the files."""
+    recordings = {}
+    for i, path in enumerate(paths):
+        if progress:
+            done = int(20 * i / len(paths))
+            print(f"\revaluate [{'#' * done}{'.' * (20 - done)}] {i + 1}/{len(paths)} {path}",
+                  end="" if sys.stderr.isatty() else "\n", file=sys.stderr, flush=True)
+        rec = read_recording(path)
+        recordings[rec.name] = evaluate_recording(rec, method, params, offline, gyro_offset)
+    if progress and sys.stderr.isatty():
+        print(file=sys.stderr)
+    labels = next(iter(recordings.values())).keys()
+    mean = {label: {m: float(np.mean([r[label][m] for r in recordings.values()])) for m in METRICS}
+            for label in labels}
+    return {"recordings": recordings, "mean": mean}

@@ -1,0 +1,137 @@
+"""Real-recording tools: the offline Wiener smoother, the gyro-offset estimator and
+`attitude evaluate` (on small synthetic recordings written here; the BROAD run is a
+benchmark, tests/test_broad_benchmark.py)."""
+import json
+import math
+
+import numpy as np
+import pytest
+from scipy import integrate
+from scipy.io import savemat
+from scipy.spatial.transform import Rotation
+
+from blocks import accuracy as ac
+from blocks import earth_filters as ef
+from systems import experiments as ex
+from systems.batch import estimate
+from systems.cli import main
+from systems.errors import inclination_error, quaternion_errors
+from systems.motion import ClosedFormMotion
+from systems.sensor_model import ImuModel
+
+FS = 100.0
+
+
+@pytest.mark.parametrize("a", [0.5, 1.0, 2.0])
+def test_smoother_mean_square_error_is_the_integral_of_eq41(a):
+    dn, dv = math.radians(0.1), 1.0
+    wg = ef.omega_g(dn, dv)
+    spectrum = lambda w: ac.smoother_error_spectrum(ef.butterworth(wg), np.array([w]), dn, a * dv)[0]
+    numeric = 2 * sum(integrate.quad(spectrum, lo, hi, limit=400)[0] for lo, hi in ((1e-12, wg), (wg, np.inf)))
+    assert numeric / (2 * math.pi) == pytest.approx(ac.smoother_mean_square_gravity_error(dn, dv, a), rel=1e-8)
+
+
+def test_offline_smoother_simulated_error_agrees_with_its_derivation():
+    dn, dv = math.radians(0.1), 1.0
+    run = ex.simulate_human(dn, dv, duration=20000.0, seed=3, offline=True)
+    assert ex.rms(run.errors) == pytest.approx(ac.smoother_rms_attitude_error(dn, dv, 1.0, ex.PAPER_G), rel=0.10)
+    # and it halves the causal filter's error, as the derivation says
+    online = ex.simulate_human(dn, dv, duration=20000.0, seed=3)
+    assert ex.rms(run.errors) / ex.rms(online.errors) == pytest.approx(0.5, rel=0.1)
+
+
+def test_offline_needs_an_earth_frame_filter():
+    rng = np.random.default_rng(0)
+    gyr, acc = rng.normal(0, 0.1, (50, 3)), rng.normal(0, 0.1, (50, 3)) + [0, 0, 9.81]
+    with pytest.raises(ValueError, match="offline smoothing needs"):
+        estimate(gyr, acc, FS, "mahony", offline=True)
+
+
+def _window(t, period=300.0, rest=60.0, ramp=2.0):
+    """0 during the first `rest` seconds of every period, 1 while moving, smooth ramps."""
+    into = np.mod(t, period)
+    up = 0.5 - 0.5 * np.cos(np.pi * np.clip((into - rest) / ramp, 0, 1))
+    down = 0.5 - 0.5 * np.cos(np.pi * np.clip((period - into) / ramp, 0, 1))
+    return np.minimum(up, down)
+
+
+def _motion_with_rests():
+    """An hour of rotation and translation with a 60 s rest every 5 minutes (closed form)."""
+    def orientation(t):
+        w = _window(t)
+        return Rotation.from_euler("ZYX", np.column_stack([
+            w * (1.0 * np.sin(0.7 * t) + 0.5 * np.sin(1.9 * t)), w * 0.6 * np.sin(1.1 * t),
+            w * 0.4 * np.sin(1.3 * t + 1.0)]))
+
+    def velocity(t):
+        return _window(t)[:, None] * 0.3 * np.column_stack([np.sin(2.3 * t), np.cos(1.7 * t), 0.5 * np.sin(3.1 * t)])
+
+    return ClosedFormMotion("rests", orientation, velocity).generate(3600.0, FS)
+
+
+def test_gyro_offset_converges_and_attitude_stays_bounded_over_an_hour():
+    motion = _motion_with_rests()
+    offset = np.radians([1.0, -1.0, 1.0])  # 1 °/s on every axis
+    imu = ImuModel(delta_n=math.radians(0.01), gyr_offset=tuple(offset), acc_noise=0.002)
+    gyr, acc = imu.apply(motion, seed=5)
+    est = estimate(gyr, acc, FS, gyro_offset=True)
+    after_first_rest = int(62 * FS)
+    assert np.degrees(np.abs(est.offset[after_first_rest:] - offset)).max() < 0.05
+    inclination = np.degrees(inclination_error(est.gravity, motion.up))
+    assert inclination[after_first_rest:].max() < 1.0
+    # no drift: the last ten minutes are no worse than the first hour's quarter
+    assert inclination[-60000:].max() < 2 * inclination[after_first_rest:int(900 * FS)].max() + 0.1
+    # without the offset estimator the same recording is far off
+    assert np.degrees(inclination_error(estimate(gyr, acc, FS).gravity, motion.up)).max() > 5.0
+
+
+def _broad_like(path, motion, quat_ref=True, movement=True):
+    gyr, acc = ImuModel(delta_n=math.radians(0.02), acc_noise=0.002).apply(motion, seed=1)
+    data = {"imu_gyr": gyr, "imu_acc": acc, "imu_mag": motion.mag, "sampling_rate": FS}
+    if quat_ref:
+        ref = motion.quat.copy()
+        ref[100:120] = np.nan  # the optical system lost the body for a moment
+        data["opt_quat"] = ref
+    if movement:
+        data["movement"] = (np.arange(len(gyr)) > 500).astype(float)
+    savemat(path, data)
+
+
+def test_evaluate_json_contract_on_synthetic_recordings(tmp_path, capsys):
+    motion = ClosedFormMotion("turns", lambda t: Rotation.from_euler("ZY", np.column_stack([
+        0.8 * np.sin(0.5 * t), 0.5 * np.sin(0.3 * t)])), lambda t: np.zeros((len(t), 3))).generate(60.0, FS)
+    for name in ("a", "b"):
+        _broad_like(tmp_path / f"{name}.mat", motion)
+    assert main(["evaluate", "--json", str(tmp_path / "a.mat"), str(tmp_path / "b.mat")]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert set(result) == {"recordings", "mean"} and set(result["recordings"]) == {"a", "b"}
+    for table in (result["recordings"]["a"], result["mean"]):
+        assert set(table) == {"wiener", "vqf", "vqf_offline", "madgwick"}
+        for row in table.values():
+            assert set(row) == {"inclination_rmse_deg", "heading_rmse_deg", "total_rmse_deg"}
+            assert row["inclination_rmse_deg"] <= row["total_rmse_deg"] + 1e-9
+    assert result["mean"]["wiener"]["inclination_rmse_deg"] < 0.5
+    assert main(["evaluate", "--json", "--offline", str(tmp_path / "a.mat")]) == 0
+    assert "wiener_offline" in json.loads(capsys.readouterr().out)["mean"]
+
+
+@pytest.mark.parametrize("case", ["no reference", "no movement flag", "corrupted"])
+def test_evaluate_without_reference_or_on_a_broken_file_fails_cleanly(tmp_path, capsys, case):
+    motion = ClosedFormMotion("still", lambda t: Rotation.from_rotvec(np.zeros((len(t), 3))),
+                              lambda t: np.zeros((len(t), 3))).generate(10.0, FS)
+    path = tmp_path / "rec.mat"
+    if case == "corrupted":
+        path.write_bytes(b"MATLAB 5.0 MAT-file; broken on purpose")
+    else:
+        _broad_like(path, motion, quat_ref=case != "no reference", movement=case != "no movement flag")
+    assert main(["evaluate", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert "attitude: error:" in err and "Traceback" not in err
+
+
+def test_quaternion_errors_split_heading_from_inclination():
+    ref = Rotation.random(20, random_state=2)
+    heading_only = Rotation.from_euler("z", np.full((20, 1), 0.3)) * ref
+    total, heading, inclination = quaternion_errors(heading_only.as_quat(scalar_first=True),
+                                                    ref.as_quat(scalar_first=True))
+    assert np.allclose(heading, 0.3) and np.allclose(inclination, 0.0, atol=1e-7) and np.allclose(total, 0.3)
