@@ -10,6 +10,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from blocks.gyro_offset import correct as correct_gyro
+from blocks.heading import with_magnetometer
 from blocks.methods import METHODS, method as get_method, stepper
 
 
@@ -24,6 +25,7 @@ class AttitudeEstimate:
     gravity: np.ndarray
     quat: np.ndarray
     offset: np.ndarray | None = None  # N×3 gyro-offset estimate, rad/s, when one was made
+    mag_accepted: np.ndarray | None = None  # N, magnetometer samples the heading used
 
     @property
     def up(self) -> np.ndarray:
@@ -52,7 +54,7 @@ def check_imu(gyr, acc, fs: float) -> tuple[np.ndarray, np.ndarray]:
 
 def estimate(
     gyr, acc, fs: float, method: str = "wiener", params: Mapping[str, float] | None = None,
-    initial_gravity=None, offline: bool = False, gyro_offset: bool = False,
+    initial_gravity=None, offline: bool = False, gyro_offset: bool = False, mag=None,
 ) -> AttitudeEstimate:
     """Estimate attitude over a recording: gyr N×3 rad/s, acc N×3 m/s², fs in Hz.
 
@@ -62,7 +64,8 @@ def estimate(
     forward, then backward over the forward estimate (for `wiener` the non-causal Wiener
     smoother, see blocks.accuracy.smoother_mean_square_gravity_error). gyro_offset: first
     estimate the gyro offset at rest and remove it (blocks.gyro_offset; the estimate is
-    returned as `offset`).
+    returned as `offset`). mag (N×3, µT): heading from the magnetometer with a guard
+    against disturbances (blocks.heading); without it the heading is the gyro's (6D).
     """
     gyr, acc = check_imu(gyr, acc, fs)
     offset = None
@@ -72,7 +75,7 @@ def estimate(
     forward = _run(step, gyr, acc, acc[0] if initial_gravity is None else initial_gravity)
     forward.offset = offset
     if not offline:
-        return forward
+        return _with_heading(forward, mag, fs)
     if not get_method(method).is_sensor_frame:
         raise ValueError(f"offline smoothing needs an earth-frame filter method "
                          f"({', '.join(n for n, m in METHODS.items() if m.is_sensor_frame)}), not {method!r}")
@@ -80,7 +83,17 @@ def estimate(
     gyr_back = np.vstack([np.zeros((1, 3)), -gyr[:0:-1]])
     backward = _run(step, gyr_back, np.ascontiguousarray(forward.gravity[::-1]), forward.gravity[-1])
     gravity = backward.gravity[::-1].copy()
-    return AttitudeEstimate(gravity, level_onto(forward.quat, gravity), offset)
+    return _with_heading(AttitudeEstimate(gravity, level_onto(forward.quat, gravity), offset), mag, fs)
+
+
+def _with_heading(est: AttitudeEstimate, mag, fs: float) -> AttitudeEstimate:
+    if mag is None:
+        return est
+    mag = np.asarray(mag, dtype=float)
+    if mag.shape != est.quat[:, :3].shape or not np.isfinite(mag).all():
+        raise ValueError(f"mag must be finite with shape {est.quat[:, :3].shape}, got {mag.shape}")
+    est.quat, est.mag_accepted = with_magnetometer(est.quat, mag, fs)
+    return est
 
 
 def _run(step, gyr, acc, initial_gravity) -> AttitudeEstimate:

@@ -38,6 +38,8 @@ def _add_real_data_flags(parser) -> None:
                         help="forward-backward smoothing of the earth-frame filter (wiener: the Wiener smoother)")
     parser.add_argument("--gyro-offset", default="on", choices=["on", "off"],
                         help="estimate and remove the gyro offset at rest (default on)")
+    parser.add_argument("--heading", default="mag", choices=["mag", "gyro"],
+                        help="heading from the magnetometer when the input has one (default), or the gyro's (6D)")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -103,7 +105,7 @@ def cmd_estimate(args) -> int:
 
     rec = read_recording(args.input, fs=args.fs, gyr_unit=args.gyr_unit, acc_unit=args.acc_unit)
     result = estimate(rec.gyr, rec.acc, rec.fs, args.method, dict(args.param), offline=args.offline,
-                      gyro_offset=args.gyro_offset == "on")
+                      gyro_offset=args.gyro_offset == "on", mag=rec.mag if args.heading == "mag" else None)
     write_estimate(args.out, rec.t, result.quat, result.up)
     print(f"attitude: {len(rec.gyr)} samples at {rec.fs:g} Hz, method {args.method} → {args.out}", file=sys.stderr)
     return 0
@@ -118,7 +120,8 @@ def cmd_evaluate(args) -> int:
     except ImportError as exc:
         raise RuntimeError(f"attitude evaluate compares with vqf and ahrs ({exc}); "
                            "install them with: pip install 'attitude-fmu[peers]'") from None
-    result = evaluate(args.files, args.method, dict(args.param), args.offline, args.gyro_offset == "on")
+    result = evaluate(args.files, args.method, dict(args.param), args.offline, args.gyro_offset == "on",
+                      args.heading == "mag")
     if args.json:
         print(json.dumps(result, indent=2))
         return 0

@@ -25,8 +25,9 @@ def errors_on_movement(quat, rec: Recording) -> dict:
 
 
 def evaluate_recording(rec: Recording, method: str = "wiener", params=None, offline: bool = False,
-                       gyro_offset: bool = True) -> dict:
-    """{method label: {metric: value}} for one recording."""
+                       gyro_offset: bool = True, use_mag: bool = True) -> dict:
+    """{method label: {metric: value}} for one recording; with a magnetometer (and use_mag)
+    the method's heading comes from it, and vqf's 9D estimate is added as "vqf_9d"."""
     if rec.quat_ref is None or rec.movement is None:
         raise RecordingError(f"{rec.name}: no optical reference (opt_quat and movement); cannot evaluate")
     if not (rec.movement & np.isfinite(rec.quat_ref).all(axis=1)).any():
@@ -34,18 +35,23 @@ def evaluate_recording(rec: Recording, method: str = "wiener", params=None, offl
     import vqf as vqf_module  # peers: the test extra (or [peers])
 
     label = f"{method}_offline" if offline else method
-    est = estimate(rec.gyr, rec.acc, rec.fs, method, params, offline=offline, gyro_offset=gyro_offset)
+    mag = rec.mag if use_mag else None
+    est = estimate(rec.gyr, rec.acc, rec.fs, method, params, offline=offline, gyro_offset=gyro_offset, mag=mag)
     gyr, acc = np.ascontiguousarray(rec.gyr), np.ascontiguousarray(rec.acc)
-    return {
+    table = {
         label: errors_on_movement(est.quat, rec),
         "vqf": errors_on_movement(peer_quaternions("vqf", gyr, acc, rec.fs), rec),
         "vqf_offline": errors_on_movement(vqf_module.offlineVQF(gyr, acc, None, 1.0 / rec.fs)["quat6D"], rec),
         "madgwick": errors_on_movement(peer_quaternions("madgwick", gyr, acc, rec.fs), rec),
     }
+    if mag is not None:
+        nine_d = vqf_module.VQF(1.0 / rec.fs).updateBatch(gyr, acc, np.ascontiguousarray(mag))["quat9D"]
+        table["vqf_9d"] = errors_on_movement(nine_d, rec)
+    return table
 
 
 def evaluate(paths, method: str = "wiener", params=None, offline: bool = False, gyro_offset: bool = True,
-             progress: bool = True) -> dict:
+             use_mag: bool = True, progress: bool = True) -> dict:
     """{"recordings": {name: {label: metrics}}, "mean": {label: metrics}} over the files."""
     recordings = {}
     for i, path in enumerate(paths):
@@ -54,10 +60,10 @@ def evaluate(paths, method: str = "wiener", params=None, offline: bool = False, 
             print(f"\revaluate [{'#' * done}{'.' * (20 - done)}] {i + 1}/{len(paths)} {path}",
                   end="" if sys.stderr.isatty() else "\n", file=sys.stderr, flush=True)
         rec = read_recording(path)
-        recordings[rec.name] = evaluate_recording(rec, method, params, offline, gyro_offset)
+        recordings[rec.name] = evaluate_recording(rec, method, params, offline, gyro_offset, use_mag)
     if progress and sys.stderr.isatty():
         print(file=sys.stderr)
-    labels = next(iter(recordings.values())).keys()
+    labels = set.intersection(*(set(r) for r in recordings.values()))  # vqf_9d needs every file's mag
     mean = {label: {m: float(np.mean([r[label][m] for r in recordings.values()])) for m in METRICS}
-            for label in labels}
+            for label in next(iter(recordings.values())) if label in labels}
     return {"recordings": recordings, "mean": mean}

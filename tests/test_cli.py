@@ -50,7 +50,7 @@ def test_estimate_csv_writes_the_contracted_columns_equal_to_the_batch_path(tmp_
                  "--param", "delta_n=0.001", "--param", "delta_v=1.5"]) == 0
     header, data = _read_output(tmp_path / "out.csv")
     assert header == list(OUTPUT_COLUMNS)
-    ref = estimate(gyr, acc, FS, "wiener", {"delta_n": 0.001, "delta_v": 1.5})
+    ref = estimate(gyr, acc, FS, "wiener", {"delta_n": 0.001, "delta_v": 1.5}, gyro_offset=True)  # CLI defaults
     assert np.allclose(data[:, 0], np.arange(1, len(gyr) + 1) / FS)
     assert np.abs(data[:, 1:5] - ref.quat).max() < 1e-9
     assert np.abs(data[:, 5:8] - ref.up).max() < 1e-9
@@ -64,16 +64,20 @@ def test_estimate_without_t_column_needs_fs_and_honours_units(tmp_path, imu):
     assert main(["estimate", str(tmp_path / "in.csv"), "--out", str(out)]) == 2
     assert main(["estimate", str(tmp_path / "in.csv"), "--out", str(out), "--fs", "100",
                  "--gyr-unit", "deg/s", "--acc-unit", "g", "--method", "first_order"]) == 0
-    ref = estimate(gyr, acc, FS, "first_order")
+    ref = estimate(gyr, acc, FS, "first_order", gyro_offset=True)
     assert np.abs(_read_output(out)[1][:, 1:5] - ref.quat).max() < 1e-8
 
 
 def test_estimate_reads_a_broad_mat_recording(tmp_path, imu):
     gyr, acc = imu
-    savemat(tmp_path / "rec.mat", {"imu_gyr": gyr, "imu_acc": acc, "imu_mag": np.ones_like(gyr),
+    mag = np.tile([0.0, 20.0, -45.0], (len(gyr), 1))
+    savemat(tmp_path / "rec.mat", {"imu_gyr": gyr, "imu_acc": acc, "imu_mag": mag,
                                    "sampling_rate": FS, "movement": np.ones(len(gyr))})
-    assert main(["estimate", str(tmp_path / "rec.mat"), "--out", str(tmp_path / "out.csv")]) == 0
-    assert np.abs(_read_output(tmp_path / "out.csv")[1][:, 1:5] - estimate(gyr, acc, FS).quat).max() < 1e-9
+    for heading, ref_mag in (("mag", mag), ("gyro", None)):
+        out = tmp_path / f"out_{heading}.csv"
+        assert main(["estimate", str(tmp_path / "rec.mat"), "--out", str(out), "--heading", heading]) == 0
+        ref = estimate(gyr, acc, FS, gyro_offset=True, mag=ref_mag)
+        assert np.abs(_read_output(out)[1][:, 1:5] - ref.quat).max() < 1e-9
 
 
 def _bad_inputs(tmp_path, gyr, acc):
@@ -139,5 +143,5 @@ def test_estimate_runs_every_method_as_the_batch_path_does(tmp_path, imu, method
     gyr, acc = imu
     _write_csv(tmp_path / "in.csv", _imu_columns(gyr, acc))
     assert main(["estimate", str(tmp_path / "in.csv"), "--out", str(tmp_path / "out.csv"), "--method", method]) == 0
-    ref = estimate(gyr, acc, FS, method)
+    ref = estimate(gyr, acc, FS, method, gyro_offset=True)
     assert np.abs(_read_output(tmp_path / "out.csv")[1][:, 1:5] - ref.quat).max() < 1e-9
