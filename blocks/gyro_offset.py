@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from .jit import kernel
-from .methods import Param
+from .methods import Param, resolve_params
 
 PARAMS = (
     Param("rest_gyr", math.radians(2.0), "rad/s", "largest deviation of the gyro from its low-pass at rest"),
@@ -27,14 +27,7 @@ STATE_NAMES = ("glp_x", "glp_y", "glp_z", "alp_x", "alp_y", "alp_z", "rest_s", "
 
 
 def resolve(overrides=None) -> dict:
-    known = {p.name: p.default for p in PARAMS}
-    for name, value in (overrides or {}).items():
-        if name not in known:
-            raise ValueError(f"unknown gyro-offset parameter {name!r}; known: {', '.join(known)}")
-        if not (math.isfinite(value) and value > 0):
-            raise ValueError(f"gyro-offset parameter {name} must be a finite positive number, got {value!r}")
-        known[name] = float(value)
-    return known
+    return resolve_params(PARAMS, overrides, "the gyro-offset estimator")
 
 
 def coefficients(params, Ts: float) -> np.ndarray:

@@ -19,7 +19,7 @@ import math
 import numpy as np
 
 from .jit import kernel
-from .methods import Param
+from .methods import Param, resolve_params
 from .quaternion import quat_multiply, quat_rotate
 
 PARAMS = (
@@ -32,14 +32,7 @@ PARAMS = (
 
 
 def resolve(overrides=None) -> dict:
-    known = {p.name: p.default for p in PARAMS}
-    for name, value in (overrides or {}).items():
-        if name not in known:
-            raise ValueError(f"unknown heading parameter {name!r}; known: {', '.join(known)}")
-        if not (math.isfinite(value) and value > 0):
-            raise ValueError(f"heading parameter {name} must be a finite positive number, got {value!r}")
-        known[name] = float(value)
-    return known
+    return resolve_params(PARAMS, overrides, "the heading estimator")
 
 
 @kernel()

@@ -34,6 +34,22 @@ class Param:
     allow_zero: bool = False
 
 
+def resolve_params(params: tuple[Param, ...], overrides: Mapping[str, float] | None, owner: str) -> dict:
+    """The defaults of params updated by overrides; unknown names, non-finite values and
+    non-positive ones (negative ones where allow_zero) are refused, naming owner."""
+    known = {p.name: p for p in params}
+    values = {p.name: p.default for p in params}
+    for name, value in (overrides or {}).items():
+        if name not in known:
+            raise ValueError(f"unknown parameter {name!r} for {owner}; known: {', '.join(known)}")
+        low_ok = value >= 0 if known[name].allow_zero else value > 0
+        if not (isinstance(value, (int, float)) and math.isfinite(value) and low_ok):
+            kind = "non-negative" if known[name].allow_zero else "positive"
+            raise ValueError(f"parameter {name} must be a finite {kind} number, got {value!r}")
+        values[name] = float(value)
+    return values
+
+
 @dataclass(frozen=True)
 class Method:
     """design gives the earth-frame filter of a sensor-frame method; kernel is the module
@@ -47,20 +63,7 @@ class Method:
 
     def resolve(self, overrides: Mapping[str, float] | None = None) -> dict[str, float | None]:
         """Defaults updated by overrides; unknown names and non-positive values are refused."""
-        known = {p.name: p.default for p in self.params}
-        for name, value in (overrides or {}).items():
-            if name not in known:
-                raise ValueError(
-                    f"unknown parameter {name!r} for method {self.name!r}; "
-                    f"known: {', '.join(known)}"
-                )
-            param = next(p for p in self.params if p.name == name)
-            low_ok = value >= 0 if param.allow_zero else value > 0
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and low_ok):
-                kind = "non-negative" if param.allow_zero else "positive"
-                raise ValueError(f"parameter {name} must be a finite {kind} number, got {value!r}")
-            known[name] = float(value)
-        return known
+        return resolve_params(self.params, overrides, f"method {self.name!r}")
 
     @property
     def is_sensor_frame(self) -> bool:
