@@ -1,4 +1,4 @@
-"""The `attitude` command line: estimate, evaluate, table1, verify, compare, bode, bench."""
+"""The `attitude` command line: estimate, evaluate, plot, table1, verify, compare, bode, bench."""
 from __future__ import annotations
 
 import argparse
@@ -69,6 +69,14 @@ def build_parser() -> argparse.ArgumentParser:
     ev.add_argument("--json", action="store_true")
     _add_real_data_flags(ev)
 
+    pl = sub.add_parser("plot", help="a recording's error over time and its spectrum against eq. 42 (PNG)")
+    pl.add_argument("file", metavar="FILE")
+    pl.add_argument("--method", default="wiener", choices=sorted(METHODS))
+    pl.add_argument("--out", required=True, help="PNG to write")
+    pl.add_argument("--param", type=_param, action="append", default=[], metavar="NAME=VALUE")
+    pl.add_argument("--offline", action="store_true")
+    pl.add_argument("--gyro-offset", default="on", choices=["on", "off"])
+
     t1 = sub.add_parser("table1", help="Rizun's Table 1: analytic (eq. 50) and simulated RMS attitude error")
     t1.add_argument("--json", action="store_true", help="print JSON instead of a table")
     t1.add_argument("--duration", type=float, default=20000.0, help="simulated seconds per cell (default 20000)")
@@ -132,6 +140,15 @@ def cmd_evaluate(args) -> int:
     for name, table in rows:
         cells = " ".join(f"{'/'.join(format(table[l][m], '.2f') for m in reversed(METRICS)):>22}" for l in labels)
         print(f"{name:>45} {cells}")
+    return 0
+
+
+def cmd_plot(args) -> int:
+    from .plot import plot_recording
+
+    result = plot_recording(args.file, args.out, args.method, dict(args.param), args.offline,
+                            args.gyro_offset == "on")
+    print(f"attitude: wrote {args.out} (inclination RMSE {result['inclination_rmse_deg']:.2f}°)", file=sys.stderr)
     return 0
 
 
@@ -250,7 +267,7 @@ def cmd_bench(args) -> int:
 
 def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
-    handler = {"estimate": cmd_estimate, "evaluate": cmd_evaluate, "table1": cmd_table1, "verify": cmd_verify, "compare": cmd_compare,
+    handler = {"estimate": cmd_estimate, "evaluate": cmd_evaluate, "plot": cmd_plot, "table1": cmd_table1, "verify": cmd_verify, "compare": cmd_compare,
                "bode": cmd_bode, "bench": cmd_bench}[args.command]
     try:
         return handler(args)

@@ -157,3 +157,15 @@ def test_magnetometer_heading_follows_the_field_and_survives_a_disturbance():
     assert est.mag_accepted[20000:30000].mean() < 0.2 and est.mag_accepted[31000:].all()
     assert heading[20000:30000].max() < 30.0  # about the gyro's 0.2 °/s over 100 s, not the field's pull
     assert heading[40000:].max() < 3.0
+
+
+def test_plot_writes_a_png_and_refuses_a_recording_without_reference(tmp_path, capsys):
+    motion = ClosedFormMotion("turns", lambda t: Rotation.from_euler("ZY", np.column_stack([
+        0.8 * np.sin(0.5 * t), 0.5 * np.sin(0.3 * t)])), lambda t: np.zeros((len(t), 3))).generate(60.0, FS)
+    _broad_like(tmp_path / "a.mat", motion)
+    out = tmp_path / "a.png"
+    assert main(["plot", str(tmp_path / "a.mat"), "--method", "wiener", "--out", str(out)]) == 0
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    _broad_like(tmp_path / "b.mat", motion, quat_ref=False)
+    assert main(["plot", str(tmp_path / "b.mat"), "--out", str(tmp_path / "b.png")]) == 2
+    assert "no optical reference" in capsys.readouterr().err
