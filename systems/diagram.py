@@ -5,8 +5,8 @@ from __future__ import annotations
 import control
 import numpy as np
 
-from blocks.methods import method as get_method
-from blocks.sensor_frame import GRAVITY_OUTPUTS, QUAT_NAMES, initial_state, sensor_frame_system
+from blocks.methods import estimator_system, stepper
+from blocks.sensor_frame import GRAVITY_OUTPUTS, QUAT_NAMES
 
 from .errors import inclination_error
 from .motion import AXES, HumanMotion
@@ -34,14 +34,14 @@ def closed_loop(motion: HumanMotion, imu: ImuModel, fs: float, method: str = "wi
 
     Inputs: NOISE_INPUTS (unit-normal samples); outputs: incl_err (rad), ghat_*, q_*.
     """
-    filt = get_method(method).filter(params)
-    blocks = [motion.system(fs), imu.system(fs), sensor_frame_system(filt, dt=1.0 / fs),
+    blocks = [motion.system(fs), imu.system(fs), estimator_system(method, params, 1.0 / fs),
               attitude_error_system(fs)]
     diagram = control.interconnect(
         blocks, inplist=NOISE_INPUTS, outlist=["incl_err"] + GRAVITY_OUTPUTS + QUAT_NAMES,
         name="closed_loop",
     )
-    x0 = np.concatenate([motion.initial_state(), initial_state(filt, 1.0 / fs, [0.0, 0.0, motion.g])])
+    start = stepper(method, tuple(sorted((params or {}).items())), 1.0 / fs).initial_state([0.0, 0.0, motion.g])
+    x0 = np.concatenate([motion.initial_state(), start])
     return diagram, x0
 
 

@@ -56,16 +56,17 @@ def test_incline_motion_has_zero_mean_acceleration_and_the_stated_peak():
     assert np.allclose(earth[:, 1], 0) and np.allclose(earth[:, 0], earth[:, 2])  # along the 45° slope
 
 
-def test_closed_loop_diagram_equals_the_batch_pipeline():
+@pytest.mark.parametrize("method", ["wiener", "luinge"])
+def test_closed_loop_diagram_equals_the_batch_pipeline(method):
     motion = HumanMotion()
     imu = ImuModel(delta_n=math.radians(0.1), gyr_offset=(0.01, 0.0, -0.01), acc_noise=0.01)
     fs = 100.0
-    noise, resp = simulate_closed_loop(motion, imu, fs, duration=5.0, seed=3)
+    noise, resp = simulate_closed_loop(motion, imu, fs, duration=5.0, method=method, seed=3)
     state = motion.initial_state()
     truth = np.empty((len(noise), 10))
     _human_run(state, np.ascontiguousarray(noise[:, :6]), motion.coefficients(fs), truth)
     gyr, acc = imu.measure(truth[:, 0:3], truth[:, 3:6], noise[:, 6:12], fs)
-    est = estimate(gyr, acc, fs, initial_gravity=[0, 0, motion.g])
+    est = estimate(gyr, acc, fs, method, initial_gravity=[0, 0, motion.g])
     up = Rotation.from_quat(truth[:, 6:10], scalar_first=True).inv().apply([0, 0, 1])
     assert np.abs(resp.outputs[1:4].T - est.gravity).max() <= 1e-12
     assert np.abs(resp.outputs[4:8].T - est.quat).max() <= 1e-12
