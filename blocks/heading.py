@@ -35,44 +35,58 @@ def resolve(overrides=None) -> dict:
     return resolve_params(PARAMS, overrides, "the heading estimator")
 
 
+def coefficients(params, Ts: float) -> np.ndarray:
+    """[a_heading, a_reference, mag_norm_tol, mag_dip_tol, heading_clip]; a_* = 1 − exp(−Ts/τ)."""
+    return np.array([1.0 - math.exp(-Ts / params["tau_heading"]), 1.0 - math.exp(-Ts / params["tau_reference"]),
+                     params["mag_norm_tol"], params["mag_dip_tol"], params["heading_clip"]])
+
+
+def initial_state() -> np.ndarray:
+    """[ψ_c (rad), reference norm (negative: not learned yet), reference dip (rad)]."""
+    return np.array([0.0, -1.0, 0.0])
+
+
+@kernel(inline=True)
+def heading_step(state, coef, q, m_sensor):
+    """One sample: (q turned by the updated ψ_c, whether the field was used). q is the
+    attitude filter's orientation (4-tuple), m_sensor the field (3-tuple); state in place."""
+    a_heading, a_reference, norm_tol, dip_tol, clip = coef[0], coef[1], coef[2], coef[3], coef[4]
+    half = 0.5 * state[0]
+    m = quat_rotate(quat_multiply((math.cos(half), 0.0, 0.0, math.sin(half)), q), m_sensor)
+    horizontal = math.sqrt(m[0] * m[0] + m[1] * m[1])
+    norm = math.sqrt(horizontal * horizontal + m[2] * m[2])
+    ok = False
+    if norm > 0.0 and horizontal > 0.0:
+        dip = math.atan2(-m[2], horizontal)
+        if state[1] < 0.0:
+            state[1], state[2], ok = norm, dip, True
+            state[0] = math.atan2(m[0], m[1])
+        elif abs(norm - state[1]) <= norm_tol * state[1] and abs(dip - state[2]) <= dip_tol:
+            ok = True
+            state[0] += a_heading * min(clip, max(-clip, math.atan2(m[0], m[1])))
+            state[1] += a_reference * (norm - state[1])
+            state[2] += a_reference * (dip - state[2])
+    state[0] = math.atan2(math.sin(state[0]), math.cos(state[0]))
+    half = 0.5 * state[0]
+    return quat_multiply((math.cos(half), 0.0, 0.0, math.sin(half)), q), ok
+
+
 @kernel()
-def run(quat, mag, a_heading, a_reference, norm_tol, dip_tol, clip, out, accepted):
+def run(state, coef, quat, mag, out, accepted):
     """Per sample: out (N×4) the orientation with magnetometer heading, accepted (N) whether
-    the field passed the guard. quat N×4 (sensor → earth), mag N×3 (any unit)."""
-    psi = 0.0
-    ref_norm = -1.0  # not yet learned
-    ref_dip = 0.0
+    the field passed the guard. quat N×4 (sensor → earth), mag N×3 (any unit); state
+    (see initial_state) is carried over from call to call."""
     for k in range(quat.shape[0]):
-        q = (quat[k, 0], quat[k, 1], quat[k, 2], quat[k, 3])
-        half = 0.5 * psi
-        turned = quat_multiply((math.cos(half), 0.0, 0.0, math.sin(half)), q)
-        m = quat_rotate(turned, (mag[k, 0], mag[k, 1], mag[k, 2]))
-        horizontal = math.sqrt(m[0] * m[0] + m[1] * m[1])
-        norm = math.sqrt(horizontal * horizontal + m[2] * m[2])
-        ok = False
-        if norm > 0.0 and horizontal > 0.0:
-            dip = math.atan2(-m[2], horizontal)
-            if ref_norm < 0.0:
-                ref_norm, ref_dip, ok = norm, dip, True
-                psi = math.atan2(m[0], m[1])
-            elif abs(norm - ref_norm) <= norm_tol * ref_norm and abs(dip - ref_dip) <= dip_tol:
-                ok = True
-                psi += a_heading * min(clip, max(-clip, math.atan2(m[0], m[1])))
-                ref_norm += a_reference * (norm - ref_norm)
-                ref_dip += a_reference * (dip - ref_dip)
-        psi = math.atan2(math.sin(psi), math.cos(psi))
-        half = 0.5 * psi
-        out[k, 0], out[k, 1], out[k, 2], out[k, 3] = quat_multiply((math.cos(half), 0.0, 0.0, math.sin(half)), q)
+        turned, ok = heading_step(state, coef, (quat[k, 0], quat[k, 1], quat[k, 2], quat[k, 3]),
+                                  (mag[k, 0], mag[k, 1], mag[k, 2]))
+        out[k, 0], out[k, 1], out[k, 2], out[k, 3] = turned
         accepted[k] = ok
 
 
 def with_magnetometer(quat, mag, fs: float, params=None):
     """(orientation with magnetometer heading N×4, accepted N) for a whole recording."""
-    p = resolve(params)
-    Ts = 1.0 / fs
     out = np.empty_like(quat)
     accepted = np.empty(len(quat), dtype=np.bool_)
-    run(np.ascontiguousarray(quat), np.ascontiguousarray(mag, dtype=float),
-        1.0 - math.exp(-Ts / p["tau_heading"]), 1.0 - math.exp(-Ts / p["tau_reference"]),
-        p["mag_norm_tol"], p["mag_dip_tol"], p["heading_clip"], out, accepted)
+    run(initial_state(), coefficients(resolve(params), 1.0 / fs), np.ascontiguousarray(quat),
+        np.ascontiguousarray(mag, dtype=float), out, accepted)
     return out, accepted

@@ -7,6 +7,10 @@ from typing import Mapping
 
 import numpy as np
 
+from .heading import coefficients as heading_coefficients
+from .heading import heading_step
+from .heading import initial_state as heading_initial_state
+from .heading import resolve as heading_resolve
 from .jit import kernel
 from .methods import method as get_method, stepper
 from .quaternion import quat_euler_zyx
@@ -14,6 +18,7 @@ from .sensor_frame import sensor_frame_step
 
 IO_INPUTS = slice(0, 6)  # gyr x, y, z (rad/s), acc x, y, z (m/s²)
 IO_OUTPUTS = slice(6, 16)  # q w, x, y, z; unit up x, y, z; roll, pitch, yaw (rad)
+IO_MAG = slice(16, 19)  # magnetic field x, y, z (µT), for heading=True
 
 
 @kernel(inline=True)
@@ -25,46 +30,56 @@ def _finite_inputs(io):
 
 
 @kernel(inline=True)
-def _write_outputs(io, q):
-    """io[10:13] holds ĝ: normalise it; q and its Euler angles into io[6:10], io[13:16]."""
+def _write_outputs(io, q, heading_state, heading_coef, heading):
+    """io[10:13] holds ĝ: normalise it; q, turned to the magnetometer's heading when asked
+    and io[16:19] is finite, and its Euler angles into io[6:10], io[13:16]."""
     norm = math.sqrt(io[10] * io[10] + io[11] * io[11] + io[12] * io[12])
     for i in range(3):
         io[10 + i] /= norm
-    for i in range(4):
-        io[6 + i] = q[i]
-    io[13], io[14], io[15] = quat_euler_zyx((q[0], q[1], q[2], q[3]))
+    out = (q[0], q[1], q[2], q[3])
+    if heading and math.isfinite(io[16]) and math.isfinite(io[17]) and math.isfinite(io[18]):
+        out, used = heading_step(heading_state, heading_coef, out, (io[16], io[17], io[18]))
+    io[6], io[7], io[8], io[9] = out
+    io[13], io[14], io[15] = quat_euler_zyx(out)
 
 
 @kernel()
-def online_step(X, q, Xr, io, Ad, Bd, C, D, Ts):
-    """One sample through sensor_frame_step with its inputs in io[0:6]; writes io[6:16].
-
-    Returns False, touching nothing, when an input is not finite. (The sensor-frame
-    methods' path: one compiled call per sample.)
+def online_step(X, q, Xr, io, Ad, Bd, C, D, Ts, heading_state, heading_coef, heading):
+    """One sample through sensor_frame_step with its inputs in io[0:6] (io[16:19] the
+    field); writes io[6:16]. Returns False, touching nothing, when an input is not finite.
+    (The sensor-frame methods' path: one compiled call per sample.)
     """
     if not _finite_inputs(io):
         return False
     rows = io[0:6].reshape((2, 3))
     sensor_frame_step(X, q, rows[0:1], rows[1:2], 0, Ad, Bd, C, D, Ts, Xr, io[10:13].reshape((1, 3)))
-    _write_outputs(io, q)
+    _write_outputs(io, q, heading_state, heading_coef, heading)
     return True
+
+
+@kernel()
+def finish_outputs(io, q, heading_state, heading_coef, heading):
+    """The other methods' path: _write_outputs after their own step."""
+    _write_outputs(io, q, heading_state, heading_coef, heading)
 
 
 class OnlineEstimator:
     """State of one estimator between samples.
 
     method and params as for `attitude estimate`; they are validated here. Inputs go to
-    io[0:6], outputs come from io[6:16] (see IO_INPUTS, IO_OUTPUTS). The filter starts
+    io[0:6] (and the magnetometer to io[16:19] with heading=True: blocks.heading, as the
+    batch path's mag argument), outputs come from io[6:16] (see IO_*). The filter starts
     at rest on the first accelerometer sample with non-zero norm, as the batch path
     starts on its first sample; until then `ready` is False.
     """
 
-    def __init__(self, method: str = "wiener", params: Mapping[str, float] | None = None):
+    def __init__(self, method: str = "wiener", params: Mapping[str, float] | None = None, heading: bool = False):
         get_method(method).resolve(params)  # refuse unknown methods and bad parameters now
         self.sensor_frame = get_method(method).is_sensor_frame
         self.method = method
         self.params = tuple(sorted((params or {}).items()))
-        self.io = np.zeros(16)
+        self.heading = heading
+        self.io = np.zeros(19)
         self._Ts = None
         self.reset()
 
@@ -72,25 +87,30 @@ class OnlineEstimator:
         """Forget all samples."""
         self.state = None
         self._quat = np.zeros((1, 4))
+        self._heading_state = heading_initial_state()
         self.io[IO_OUTPUTS] = (1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0)
 
     @property
     def ready(self) -> bool:
         return self.state is not None
 
-    def step(self, gyr, acc, Ts: float) -> bool:
-        """Take one sample: gyr (rad/s) over the last Ts seconds, acc (m/s²) now."""
+    def step(self, gyr, acc, Ts: float, mag=(0.0, 0.0, 0.0)) -> bool:
+        """Take one sample: gyr (rad/s) over the last Ts seconds, acc (m/s²) and mag (µT) now."""
         self.io[0:3] = gyr
         self.io[3:6] = acc
+        self.io[IO_MAG] = mag
         return self.step_io(Ts)
 
     def step_io(self, Ts: float) -> bool:
-        """Take the sample in io[0:6] (Ts in s). Returns whether io[6:16] holds a new estimate:
-        False for a non-finite input (the estimate is held) or before gravity was seen."""
+        """Take the sample in io[0:6] (and io[16:19] with heading; Ts in s). Returns whether
+        io[6:16] holds a new estimate: False for a non-finite input (the estimate is held)
+        or before gravity was seen."""
         if Ts != self._Ts:
             if not (math.isfinite(Ts) and Ts > 0):
                 raise ValueError(f"sample time must be a finite positive number of seconds, got {Ts!r}")
             self._stepper, self._Ts = stepper(self.method, self.params, Ts), Ts
+            self._heading_coef = heading_coefficients(heading_resolve(), Ts)
+
         if self.state is None:
             acc = self.io[3:6]
             if not (np.isfinite(self.io[IO_INPUTS]).all() and np.any(acc)):
@@ -101,10 +121,11 @@ class OnlineEstimator:
                 self._views = (self.state[: 3 * n].reshape(n, 3), self.state[3 * n:], np.empty((n, 3)))
         if self.sensor_frame:
             d = self._stepper.disc
-            return online_step(*self._views, self.io, d.Ad, d.Bd, d.C, d.D, d.Ts)
-        if not _finite_inputs(self.io):
+            return online_step(*self._views, self.io, d.Ad, d.Bd, d.C, d.D, d.Ts,
+                               self._heading_state, self._heading_coef, self.heading)
+        if not np.isfinite(self.io[IO_INPUTS]).all():
             return False
         rows = self.io[0:6].reshape(2, 3)
         self._stepper.run(self.state, rows[0:1], rows[1:2], self.io[10:13].reshape(1, 3), self._quat)
-        _write_outputs(self.io, self._quat[0])
+        finish_outputs(self.io, self._quat[0], self._heading_state, self._heading_coef, self.heading)
         return True

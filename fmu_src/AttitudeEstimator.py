@@ -12,7 +12,6 @@ from fmu_support import IN, OUT, PAR, Fmi2Status, ProjectSlave, fmi_unit
 
 from blocks.methods import METHODS
 from blocks.online import OnlineEstimator
-from systems.motion import EARTH_FIELD_UT
 
 
 
@@ -33,13 +32,14 @@ class AttitudeEstimator(ProjectSlave):
         super().__init__(**kwargs)
         self.vector("gyr", (0.0, 0.0, 0.0), "rad/s", "gyro {c}, mean rate over the step", IN)
         self.vector("acc", (0.0, 0.0, 9.81), "m/s2", "specific force {c} at the end of the step", IN)
-        self.vector("mag", EARTH_FIELD_UT, "uT", "magnetic field {c} (unused by the 6D methods)", IN)
+        self.vector("mag", (0.0, 0.0, 0.0), "uT", "magnetic field {c}; all 0: no magnetometer (heading from the gyro)", IN)
         self.vector("q", (1.0, 0.0, 0.0, 0.0), "1", "orientation quaternion {c}, sensor -> earth (ENU)", OUT, "wxyz")
         self.vector("g", (0.0, 0.0, 1.0), "1", "estimated unit up-vector {c}, sensor coordinates", OUT)
         for name in ("roll", "pitch", "yaw"):
             self.real(name, 0.0, "rad", f"{name} (Z-Y-X Euler angles of q; derived output)", OUT)
         self.boolean_output("valid", False, "an estimate is available and the last inputs were finite")
         self.parameter("method", "wiener", f"estimator: {', '.join(METHODS)}")
+        self.parameter("heading", "mag", "heading source: mag (magnetometer, guarded against disturbances) or gyro")
         self.real("Ts", 0.01, "s", "sample time the estimator expects (other step sizes are re-discretised)", PAR)
         for name, (unit, doc) in tuning_parameters().items():
             self.real(name, 0.0, unit, doc, PAR)
@@ -50,8 +50,10 @@ class AttitudeEstimator(ProjectSlave):
         if not (math.isfinite(self.Ts) and self.Ts > 0):
             self.fail(f"Ts must be a finite positive number of seconds, got {self.Ts!r}")
         params = {name: getattr(self, name) for name in tuning_parameters() if getattr(self, name) != 0.0}
+        if self.heading not in ("mag", "gyro"):
+            self.fail(f"invalid parameter: heading must be 'mag' or 'gyro', got {self.heading!r}")
         try:
-            self.estimator = OnlineEstimator(self.method, params)
+            self.estimator = OnlineEstimator(self.method, params, heading=self.heading == "mag")
         except ValueError as exc:
             self.fail(f"invalid parameter: {exc}")
 
@@ -65,6 +67,7 @@ class AttitudeEstimator(ProjectSlave):
         io = self.estimator.io
         io[0], io[1], io[2] = self.gyr_x, self.gyr_y, self.gyr_z
         io[3], io[4], io[5] = self.acc_x, self.acc_y, self.acc_z
+        io[16], io[17], io[18] = self.mag_x, self.mag_y, self.mag_z
         try:
             self.valid = self.estimator.step_io(step_size)
         except ValueError as exc:

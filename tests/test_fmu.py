@@ -61,6 +61,17 @@ def test_estimator_fmu_equals_the_batch_path(fmu_dir, recording, method):
     assert np.abs(out[:, 4:] - ref.up).max() < 1e-9
 
 
+def test_estimator_fmu_heading_from_its_magnetometer_inputs_equals_the_batch_path(fmu_dir):
+    motion = profile("sine_rotation").motion({"inclination_deg": 20.0}).generate(20.0, FS)
+    gyr, acc = ImuModel(delta_n=math.radians(0.05), gyr_offset=(0.0, 0.0, 0.01)).apply(motion, seed=3)
+    runner = FmuRunner(fmu_dir / "AttitudeEstimator.fmu", {}, INPUTS + ["mag_x", "mag_y", "mag_z"], OUTPUTS)
+    out, _ = runner.run(np.hstack([gyr, acc, motion.mag]), 1 / FS)
+    runner.close()
+    ref = estimate(gyr, acc, FS, mag=motion.mag)
+    assert np.abs(out[:, :4] - ref.quat).max() < 1e-9
+    assert np.abs(out[:, :4] - estimate(gyr, acc, FS).quat).max() > 1e-3  # the field was used
+
+
 def test_reset_then_second_run_is_identical(fmu_dir, recording):
     gyr, acc = recording
     runner = _estimator(fmu_dir, method="first_order")
@@ -143,7 +154,7 @@ def test_non_finite_inputs_hold_the_estimate_and_clear_valid(fmu_dir, recording,
 def _batch_pipeline(duration, seed_motion, seed_imu, delta_n, method="wiener"):
     motion = profile("human").motion().generate(duration, FS, seed_motion)
     gyr, acc = ImuModel(delta_n=delta_n).apply(motion, seed_imu)
-    return motion, estimate(gyr, acc, FS, method)
+    return motion, estimate(gyr, acc, FS, method, mag=motion.mag)  # the sensor passes the field on
 
 
 @pytest.mark.parametrize("method", sorted(METHODS))
