@@ -28,7 +28,7 @@ def _method_help() -> str:
     for m in METHODS.values():
         lines.append(f"{m.name}: {m.summary}")
         for p in m.params:
-            default = "derived" if p.default is None else f"{p.default:g}"
+            default = "unset" if p.default is None else f"{p.default:g}"
             lines.append(f"    {p.name} [{p.unit}] (default {default}): {p.doc}")
     return "\n".join(lines)
 
