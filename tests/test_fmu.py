@@ -213,7 +213,9 @@ def test_fmu_runs_in_a_fresh_environment_without_the_project(fmu_dir, recording,
             fmu.setReal([vr[n] for n in {INPUTS!r}], row.tolist())
             fmu.doStep(currentCommunicationPoint=k / {FS}, communicationStepSize=1 / {FS})
             rows.append(fmu.getReal([vr[n] for n in {OUTPUTS!r}]))
-        print(json.dumps(rows))
+        fmu.terminate()
+        fmu.freeInstance()
+        print(json.dumps(rows), flush=True)
     """)
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV")}
     proc = subprocess.run([str(python), "-c", script], capture_output=True, text=True, cwd=tmp_path, env=env)
