@@ -71,8 +71,8 @@ def bench_fmu(steps: int = 5000, repeat: int = 5, progress: bool = True) -> dict
     import tempfile
 
     from fmpy import extract, read_model_description
-    from fmpy.fmi2 import FMU2Slave
 
+    from .cosim import load_slave
     from .fmu_build import build
 
     gyr, acc = bench_recording(steps)
@@ -85,8 +85,7 @@ def bench_fmu(steps: int = 5000, repeat: int = 5, progress: bool = True) -> dict
         for path in paths:
             md = read_model_description(path)
             vr = {v.name: v.valueReference for v in md.modelVariables}
-            fmu = FMU2Slave(guid=md.guid, unzipDirectory=extract(path), instanceName=path.stem,
-                            modelIdentifier=md.coSimulation.modelIdentifier)
+            fmu = load_slave(md, extract(path), path.stem)
             fmu.instantiate()  # once: pythonfmu cannot instantiate again after fmi2FreeInstance
             fmus[path.stem] = (fmu, [vr[f"{s}_{a}"] for s in ("gyr", "acc") for a in "xyz"],
                                [vr[n] for n in ("q_w", "q_x", "q_y", "q_z", "g_x", "g_y", "g_z", "roll", "pitch", "yaw")],

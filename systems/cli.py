@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 
 from blocks.methods import METHODS
@@ -276,5 +277,18 @@ def main(argv=None) -> int:
         return EXIT_BAD_INPUT
 
 
+def entry_point() -> None:
+    """The console script: main(), then an immediate exit where FMUs were loaded
+    (see systems.cosim.fmus_loaded)."""
+    code = main()
+    from .cosim import fmus_loaded
+
+    if fmus_loaded():
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(code)
+    sys.exit(code)
+
+
 if __name__ == "__main__":
-    sys.exit(main())
+    entry_point()

@@ -21,6 +21,23 @@ from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import FMU2Slave
 from fmpy.ssp.ssd import read_ssd
 
+_loaded = False  # whether this process has loaded an FMU's library
+
+
+def load_slave(md, unzipdir, instance_name: str) -> FMU2Slave:
+    """An FMU2Slave for an extracted FMU (pythonfmu FMUs: see fmus_loaded)."""
+    global _loaded
+    _loaded = True
+    return FMU2Slave(guid=md.guid, unzipDirectory=unzipdir, modelIdentifier=md.coSimulation.modelIdentifier,
+                     instanceName=instance_name)
+
+
+def fmus_loaded() -> bool:
+    """Whether this process loaded an FMU. pythonfmu's export library finalises its Python
+    state from a library destructor, which can crash at interpreter shutdown after all
+    work is done; processes that loaded FMUs end with os._exit once they have reported."""
+    return _loaded
+
 
 class _Component:
     """One instantiated FMU of the SSD with its variable references."""
@@ -31,8 +48,7 @@ class _Component:
         self.md = read_model_description(fmu_path)
         self.variables = {v.name: v for v in self.md.modelVariables}
         self.unzipdir = extract(fmu_path)
-        self.fmu = FMU2Slave(guid=self.md.guid, unzipDirectory=self.unzipdir,
-                             modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName=element.name)
+        self.fmu = load_slave(self.md, self.unzipdir, element.name)
         self.outputs = [v.name for v in self.md.modelVariables if v.causality == "output"]
         self.real_out = [n for n in self.outputs if self.variables[n].type == "Real"]
         self.bool_out = [n for n in self.outputs if self.variables[n].type == "Boolean"]
@@ -141,8 +157,7 @@ class FmuRunner:
         self.md = read_model_description(str(fmu_path))
         self.variables = {v.name: v for v in self.md.modelVariables}
         self.unzipdir = extract(str(fmu_path))
-        self.fmu = FMU2Slave(guid=self.md.guid, unzipDirectory=self.unzipdir,
-                             modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName=Path(fmu_path).stem)
+        self.fmu = load_slave(self.md, self.unzipdir, Path(fmu_path).stem)
         self.parameters = dict(parameters or {})
         self.input_vr = [self.variables[n].valueReference for n in inputs]
         self.output_vr = [self.variables[n].valueReference for n in outputs]
