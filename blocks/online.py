@@ -14,7 +14,7 @@ from .heading import resolve as heading_resolve
 from .jit import kernel
 from .methods import method as get_method, stepper
 from .quaternion import quat_euler_zyx
-from .sensor_frame import sensor_frame_step
+from .sensor_frame import sensor_frame_step, start_gravity
 
 IO_INPUTS = slice(0, 6)  # gyr x, y, z (rad/s), acc x, y, z (m/s²)
 IO_OUTPUTS = slice(6, 16)  # q w, x, y, z; unit up x, y, z; roll, pitch, yaw (rad)
@@ -115,7 +115,7 @@ class OnlineEstimator:
             acc = self.io[3:6]
             if not (np.isfinite(self.io[IO_INPUTS]).all() and np.any(acc)):
                 return False
-            self.state = self._stepper.initial_state(acc)
+            self.state = self._stepper.initial_state(start_gravity(self.io[0:3], acc, Ts))
             if self.sensor_frame:  # views of the state and scratch space, made once
                 n = self._stepper.disc.order
                 self._views = (self.state[: 3 * n].reshape(n, 3), self.state[3 * n:], np.empty((n, 3)))

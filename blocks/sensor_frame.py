@@ -159,6 +159,15 @@ def sensor_frame_system(earth_filter, dt: float | None = None, name: str = "esti
     return stepper_system(SensorFrameStepper(DiscreteFilter.from_lti(earth_filter, dt)), dt, name)
 
 
+def start_gravity(gyr0, acc0, Ts: float) -> np.ndarray:
+    """The gravity to start at rest on, before the first sample: acc0 (m/s², measured at the
+    end of the first interval) turned back by that interval's rotation gyr0·Ts (rad), so
+    that the first step, which turns the state by gyr0·Ts, meets acc0 without the
+    one-sample slip of NOTES §1."""
+    dq = rotvec_quat(gyr0[0] * Ts, gyr0[1] * Ts, gyr0[2] * Ts)
+    return np.array(quat_rotate(dq, (acc0[0], acc0[1], acc0[2])))
+
+
 def initial_state(earth_filter, Ts: float, acc0) -> np.ndarray:
     """Initial state vector of the discrete system: at rest on acc0, q = identity."""
     return SensorFrameStepper(DiscreteFilter.from_lti(earth_filter, Ts)).initial_state(acc0)

@@ -48,18 +48,22 @@ class AttitudeEstimator(ProjectSlave):
 
     def exit_initialization_mode(self):
         if not (math.isfinite(self.Ts) and self.Ts > 0):
-            self.fail(f"Ts must be a finite positive number of seconds, got {self.Ts!r}")
-        params = {name: getattr(self, name) for name in tuning_parameters() if getattr(self, name) != 0.0}
+            self.fail(f"invalid parameter: Ts must be a finite positive number of seconds, got {self.Ts!r}")
+            return
         if self.heading not in ("mag", "gyro"):
             self.fail(f"invalid parameter: heading must be 'mag' or 'gyro', got {self.heading!r}")
+            return
+        params = {name: getattr(self, name) for name in tuning_parameters() if getattr(self, name) != 0.0}
         try:
             self.estimator = OnlineEstimator(self.method, params, heading=self.heading == "mag")
         except ValueError as exc:
             self.fail(f"invalid parameter: {exc}")
 
     def do_step(self, current_time, step_size):
+        if self.error is not None:
+            return self.refuse_step()
         if self.estimator is None:
-            self.fail("doStep before initialisation")
+            return self.fail("doStep before initialisation")
         if step_size != self.Ts and step_size not in self._warned_steps:
             self._warned_steps.add(step_size)
             self.log(f"communication step {step_size:g} s differs from Ts = {self.Ts:g} s: "
@@ -71,15 +75,10 @@ class AttitudeEstimator(ProjectSlave):
         try:
             self.valid = self.estimator.step_io(step_size)
         except ValueError as exc:
-            self.fail(str(exc))
+            return self.fail(str(exc))
         if self.valid:
             (self.q_w, self.q_x, self.q_y, self.q_z, self.g_x, self.g_y, self.g_z,
              self.roll, self.pitch, self.yaw) = io[6:16].tolist()
         elif not all(math.isfinite(v) for v in io[0:6].tolist()):
             self.log(f"t={current_time:g}: non-finite input; estimate held", Fmi2Status.warning)
         return True
-
-    def reset(self):
-        if self.estimator is not None:
-            self.estimator.reset()
-        self.valid = False

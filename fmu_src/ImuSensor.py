@@ -46,8 +46,10 @@ class ImuSensor(ProjectSlave):
         self.rng = np.random.default_rng(self.seed)
 
     def do_step(self, current_time, step_size):
+        if self.error is not None:
+            return self.refuse_step()
         if not (math.isfinite(step_size) and step_size > 0):
-            self.fail(f"step size must be positive, got {step_size!r}")
+            return self.fail(f"step size must be positive, got {step_size!r}")
         gyr, acc = self.model.measure(
             (self.omega_x, self.omega_y, self.omega_z), (self.f_x, self.f_y, self.f_z),
             self.rng.standard_normal(6), 1.0 / step_size,

@@ -39,9 +39,12 @@ class MotionProfile(ProjectSlave):
             motion = prof.motion({k: v for k, v in overrides.items() if v != 0.0}, g=self.g)
         except ValueError as exc:
             self.fail(f"invalid parameter: {exc}")
+            return
         self.stream = motion.stream(self.seed)
 
     def do_step(self, current_time, step_size):
+        if self.error is not None:
+            return self.refuse_step()
         gyr, f, q = self.stream.step(current_time + step_size, step_size)
         self.omega_x, self.omega_y, self.omega_z = (float(v) for v in gyr)
         self.f_x, self.f_y, self.f_z = (float(v) for v in f)

@@ -96,10 +96,22 @@ class ProjectSlave(Fmi2Slave):
         self.register_variable(Boolean(name, causality=Fmi2Causality.output, variability=Fmi2Variability.discrete,
                                        initial=Fmi2Initial.exact, description=description), nested=False)
 
-    def fail(self, message: str):
-        """Log an error and raise, so that the FMI call returns fmi2Error."""
+    error = None  # the message of an invalid configuration, once one was found
+
+    def fail(self, message: str) -> bool:
+        """Log an error and remember it; every later doStep returns fmi2Discard with it.
+
+        Never raise: pythonfmu turns a Python exception into fmi2Fatal and releases the
+        instance's Python objects twice, corrupting the interpreter the FMU runs in.
+        Returns False, doStep's value for fmi2Discard."""
+        self.error = message
         self.log(message, Fmi2Status.error)
-        raise ValueError(message)
+        return False
+
+    def refuse_step(self) -> bool:
+        """doStep's answer after fail(): log the reason again, fmi2Discard."""
+        self.log(f"not stepping: {self.error}", Fmi2Status.error)
+        return False
 
 
 __all__ = ["ProjectSlave", "Fmi2Status", "Integer", "String", "UNITS", "IN", "OUT", "PAR", "fmi_unit"]

@@ -12,6 +12,7 @@ from scipy.spatial.transform import Rotation
 from blocks.gyro_offset import correct as correct_gyro
 from blocks.heading import with_magnetometer
 from blocks.methods import METHODS, method as get_method, stepper
+from blocks.sensor_frame import start_gravity
 
 
 @dataclass
@@ -59,8 +60,9 @@ def estimate(
     """Estimate attitude over a recording: gyr N×3 rad/s, acc N×3 m/s², fs in Hz.
 
     params are the method's documented parameters (see blocks.methods), defaults
-    otherwise. The filter starts at rest on initial_gravity (m/s², sensor coordinates),
-    by default the first accelerometer sample. offline: the method's earth-frame filter
+    otherwise. The filter starts at rest on initial_gravity (m/s², sensor coordinates,
+    before the first sample), by default the first accelerometer sample turned back by
+    the first gyro sample (blocks.sensor_frame.start_gravity). offline: the method's earth-frame filter
     forward, then backward over the forward estimate (for `wiener` the non-causal Wiener
     smoother, see blocks.accuracy.smoother_mean_square_gravity_error). gyro_offset: first
     estimate the gyro offset at rest and remove it (blocks.gyro_offset; the estimate is
@@ -72,7 +74,9 @@ def estimate(
     if gyro_offset:
         gyr, offset = correct_gyro(gyr, acc, fs)
     step = stepper(method, tuple(sorted((params or {}).items())), 1.0 / fs)
-    forward = _run(step, gyr, acc, acc[0] if initial_gravity is None else initial_gravity)
+    if initial_gravity is None:
+        initial_gravity = start_gravity(gyr[0], acc[0], 1.0 / fs)
+    forward = _run(step, gyr, acc, initial_gravity)
     forward.offset = offset
     if not offline:
         return _with_heading(forward, mag, fs)

@@ -198,9 +198,9 @@ def cmd_verify(args) -> int:
     else:
         print(f"{'profile':>15} {'method':>14} {'rms °':>8} {'max °':>8} {'mean °':>9}  {'bound °':>8} {'on':>4}  result")
         for r in rows:
-            bound = "       —" if r["bound_deg"] is None else f"{r['bound_deg']:8.3f}"
+            bound = "       —" if r["bound_deg"] is None else f"{r['bound_deg']:8.3g}"
             result = "report" if r["bound_deg"] is None else "pass" if r["pass"] else "FAIL"
-            print(f"{r['profile']:>15} {r['method']:>14} {r['rms_deg']:8.3f} {r['max_deg']:8.3f} {r['mean_deg']:9.5f}"
+            print(f"{r['profile']:>15} {r['method']:>14} {r['rms_deg']:8.3g} {r['max_deg']:8.3g} {r['mean_deg']:9.3g}"
                   f"  {bound} {r['metric']:>4}  {result}")
         print("profiles: " + "; ".join(f"{n}: {PROFILES[n].summary}" for n in dict.fromkeys(r["profile"] for r in rows)))
     failed = [r for r in rows if not r["pass"]]

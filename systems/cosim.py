@@ -164,13 +164,7 @@ class FmuRunner:
         self.valid_vr = [self.variables["valid"].valueReference] if "valid" in self.variables else []
         self.time = 0.0
         self.fmu.instantiate(loggingOn=logging)
-        try:
-            self._initialise()
-        except FMICallException:
-            # free the failed instance now rather than during interpreter shutdown
-            self.fmu.freeInstance()
-            shutil.rmtree(self.unzipdir, ignore_errors=True)
-            raise
+        self._initialise()
 
     def _initialise(self):
         self.fmu.setupExperiment(startTime=0.0)
