@@ -18,7 +18,7 @@ import math
 import numpy as np
 
 from .jit import kernel
-from .quaternion import quat_multiply, quat_normalized, quat_rotate, rotvec_quat
+from .quaternion import quat_multiply, quat_normalized, quat_rotate, rotvec_quat, up_in_sensor, write_sample
 
 STATE_NAMES = ("q_w", "q_x", "q_y", "q_z", "P_x", "P_y")  # orientation; KF variances (rad²)
 
@@ -53,7 +53,7 @@ def luinge_step(state, Q, R, Ts, gyr, acc, k):
         q = quat_multiply(rotvec_quat(k0 * z0, k1 * z1, 0.0), q)
     q = quat_normalized(q)
     state[0], state[1], state[2], state[3] = q
-    return quat_rotate((q[0], -q[1], -q[2], -q[3]), (0.0, 0.0, 1.0))
+    return up_in_sensor(q)
 
 
 @kernel()
@@ -61,6 +61,4 @@ def run(state, coef, gyr, acc, gravity, quat):
     """Run over N samples: gravity (N×3, g·up, m/s²) and quat (N×4) written per sample."""
     Q, R, Ts, g = coef[0], coef[1], coef[2], coef[3]
     for k in range(gyr.shape[0]):
-        up = luinge_step(state, Q, R, Ts, gyr, acc, k)
-        gravity[k, 0], gravity[k, 1], gravity[k, 2] = g * up[0], g * up[1], g * up[2]
-        quat[k, 0], quat[k, 1], quat[k, 2], quat[k, 3] = state[0], state[1], state[2], state[3]
+        write_sample(gravity, quat, k, g, luinge_step(state, Q, R, Ts, gyr, acc, k), state)

@@ -14,7 +14,7 @@ import math
 import numpy as np
 
 from .jit import kernel
-from .quaternion import quat_multiply, quat_normalized, quat_rotate, rotvec_quat
+from .quaternion import quat_multiply, quat_normalized, rotvec_quat, up_in_sensor, write_sample
 
 STATE_NAMES = ("q_w", "q_x", "q_y", "q_z", "b_x", "b_y", "b_z")  # q, gyro bias b̂ (rad/s)
 
@@ -45,7 +45,7 @@ def level_on(acc0) -> np.ndarray:
 def mahony_step(state, k_P, k_I, Ts, gyr, acc, k):
     """One sample of the filter on state [q, b̂] in place; returns the unit up estimate."""
     q = (state[0], state[1], state[2], state[3])
-    v_hat = quat_rotate((q[0], -q[1], -q[2], -q[3]), (0.0, 0.0, 1.0))
+    v_hat = up_in_sensor(q)
     a0, a1, a2 = acc[k, 0], acc[k, 1], acc[k, 2]
     norm = math.sqrt(a0 * a0 + a1 * a1 + a2 * a2)
     e0 = e1 = e2 = 0.0
@@ -62,7 +62,7 @@ def mahony_step(state, k_P, k_I, Ts, gyr, acc, k):
     w2 = gyr[k, 2] - state[6] + k_P * e2
     q = quat_normalized(quat_multiply(q, rotvec_quat(w0 * Ts, w1 * Ts, w2 * Ts)))
     state[0], state[1], state[2], state[3] = q
-    return quat_rotate((q[0], -q[1], -q[2], -q[3]), (0.0, 0.0, 1.0))
+    return up_in_sensor(q)
 
 
 @kernel()
@@ -70,6 +70,4 @@ def run(state, coef, gyr, acc, gravity, quat):
     """Run over N samples: gravity (N×3, g·up, m/s²) and quat (N×4) written per sample."""
     k_P, k_I, Ts, g = coef[0], coef[1], coef[2], coef[3]
     for k in range(gyr.shape[0]):
-        up = mahony_step(state, k_P, k_I, Ts, gyr, acc, k)
-        gravity[k, 0], gravity[k, 1], gravity[k, 2] = g * up[0], g * up[1], g * up[2]
-        quat[k, 0], quat[k, 1], quat[k, 2], quat[k, 3] = state[0], state[1], state[2], state[3]
+        write_sample(gravity, quat, k, g, mahony_step(state, k_P, k_I, Ts, gyr, acc, k), state)

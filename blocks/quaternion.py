@@ -86,3 +86,16 @@ def quat_euler_zyx(q):
     pitch = math.asin(min(1.0, max(-1.0, 2.0 * (w * y - z * x))))
     yaw = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
     return roll, pitch, yaw
+
+
+@kernel(inline=True)
+def up_in_sensor(q):
+    """Earth up (+z) in sensor coordinates for the unit quaternion q (sensor → earth): R(q)ᵀ·ẑ."""
+    return quat_rotate((q[0], -q[1], -q[2], -q[3]), (0.0, 0.0, 1.0))
+
+
+@kernel(inline=True)
+def write_sample(gravity, quat, k, g, up, q):
+    """Row k of a kernel method's output: gravity g·up (m/s²) and the orientation q."""
+    gravity[k, 0], gravity[k, 1], gravity[k, 2] = g * up[0], g * up[1], g * up[2]
+    quat[k, 0], quat[k, 1], quat[k, 2], quat[k, 3] = q[0], q[1], q[2], q[3]
