@@ -99,17 +99,18 @@ class ProjectSlave(Fmi2Slave):
     error = None  # the message of an invalid configuration, once one was found
 
     def fail(self, message: str) -> bool:
-        """Log an error and remember it; every later doStep returns fmi2Discard with it.
+        """Log an error and remember it; every later doStep logs it again.
 
+        The FMU's binary (fmi2_guard.c) ends a call that logged an error in fmi2Error.
         Never raise: pythonfmu turns a Python exception into fmi2Fatal and releases the
         instance's Python objects twice, corrupting the interpreter the FMU runs in.
-        Returns False, doStep's value for fmi2Discard."""
+        Returns False, doStep's value for fmi2Discard (what an FMU without the guard returns)."""
         self.error = message
         self.log(message, Fmi2Status.error)
         return False
 
     def refuse_step(self) -> bool:
-        """doStep's answer after fail(): log the reason again, fmi2Discard."""
+        """doStep's answer after fail(): log the reason again (fmi2Error through the guard)."""
         self.log(f"not stepping: {self.error}", Fmi2Status.error)
         return False
 

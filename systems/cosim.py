@@ -164,7 +164,12 @@ class FmuRunner:
         self.valid_vr = [self.variables["valid"].valueReference] if "valid" in self.variables else []
         self.time = 0.0
         self.fmu.instantiate(loggingOn=logging)
-        self._initialise()
+        try:
+            self._initialise()
+        except FMICallException:  # fmi2Error: the instance may only be freed
+            self.fmu.freeInstance()
+            shutil.rmtree(self.unzipdir, ignore_errors=True)
+            raise
 
     def _initialise(self):
         self.fmu.setupExperiment(startTime=0.0)

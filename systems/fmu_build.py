@@ -2,12 +2,22 @@
 
 Each FMU carries fmu_src/fmu_support.py and the packages blocks/ and systems/ in its
 resources, so it runs where only numpy, scipy, control and pythonfmu are installed.
+
+On Linux and macOS the FMU's binary is fmu_src/fmi2_guard.c, compiled here with the C
+compiler ($CC, else Python's, else cc); it loads pythonfmu's library from beside it and
+gives the FMI status codes their meaning (a logged error ends the call in fmi2Error).
+Without a compiler the FMUs keep pythonfmu's binary, and a warning says what that costs.
 """
 from __future__ import annotations
 
+import os
+import shlex
 import shutil
+import subprocess
 import sys
+import sysconfig
 import tempfile
+import zipfile
 from pathlib import Path
 
 import blocks
@@ -38,7 +48,53 @@ def build(out, names=FMU_NAMES) -> list[Path]:
                                                        needsExecutionTool="false")))
         finally:
             sys.path.remove(str(SOURCE_DIR))
+        guard = compile_guard(Path(tmp) / "fmi2_guard.so")
+        if guard is not None:
+            for path in built:
+                install_guard(path, guard)
     return built
+
+
+GUARD_PLATFORMS = {"linux": "linux64", "darwin": "darwin64"}  # sys.platform prefix → FMI binaries folder
+PYTHONFMU_LIBRARY = "pythonfmu-export.so"  # the name fmi2_guard.c loads
+
+
+def compile_guard(out: Path, log=lambda m: print(m, file=sys.stderr)) -> Path | None:
+    """Compile fmi2_guard.c into the shared library out; None (with a warning) where it cannot be."""
+    platform = next((v for k, v in GUARD_PLATFORMS.items() if sys.platform.startswith(k)), None)
+    cc = shlex.split(os.environ.get("CC") or sysconfig.get_config_var("CC") or "cc")
+    command = [*cc, "-shared", "-fPIC", "-O2", "-fvisibility=hidden", "-o", str(out),
+               str(SOURCE_DIR / "fmi2_guard.c"), "-ldl", "-lpthread"]
+    consequence = ("the FMUs keep pythonfmu's own binary: an invalid parameter ends in fmi2Discard "
+                   "instead of fmi2Error, and log messages need debug logging on")
+    if platform is None:
+        log(f"warning: no FMI guard for platform {sys.platform}; {consequence}")
+        return None
+    try:
+        subprocess.run(command, check=True, capture_output=True, text=True)
+    except (OSError, subprocess.CalledProcessError) as exc:
+        detail = getattr(exc, "stderr", None) or exc
+        log(f"warning: cannot compile fmi2_guard.c ({shlex.join(command)}: {detail}); {consequence}")
+        return None
+    return out
+
+
+def install_guard(fmu: Path, guard: Path) -> None:
+    """Make guard the FMU's binary for this platform, pythonfmu's library its PYTHONFMU_LIBRARY."""
+    platform = next(v for k, v in GUARD_PLATFORMS.items() if sys.platform.startswith(k))
+    suffix = ".dylib" if platform == "darwin64" else ".so"
+    binary = f"binaries/{platform}/{fmu.stem}{suffix}"
+    staged = fmu.with_suffix(".guarded")
+    with zipfile.ZipFile(fmu) as src, zipfile.ZipFile(staged, "w", zipfile.ZIP_DEFLATED) as dst:
+        if binary not in src.namelist():
+            raise RuntimeError(f"{fmu} has no {binary} to guard")
+        for item in src.infolist():
+            name = item.filename
+            if name == binary:
+                name = f"binaries/{platform}/{PYTHONFMU_LIBRARY}"
+                dst.write(guard, binary)
+            dst.writestr(name if name != item.filename else item, src.read(item))
+    staged.replace(fmu)
 
 
 def ensure_built(fmu_dir, rebuild: bool = False, log=print) -> Path:

@@ -126,16 +126,37 @@ def test_changed_step_size_is_rediscretised_and_logged(fmu_dir, recording, capsy
     ({"method": "wiener", "omega_f": 0.1}, "unknown parameter 'omega_f'"),
     ({"heading": "compass"}, "heading must be 'mag' or 'gyro'"),
 ])
-def test_invalid_parameter_is_logged_and_the_fmu_refuses_to_step(fmu_dir, parameters, message, capsys):
-    """No Python exception crosses pythonfmu (it would end in fmi2Fatal and corrupt the
-    interpreter): the error is logged at initialisation and doStep returns fmi2Discard."""
-    runner = _estimator(fmu_dir, **parameters)
+def test_invalid_parameter_ends_initialisation_in_fmi2_error(fmu_dir, parameters, message, capsys):
+    """The model logs the error (a Python exception would end in fmi2Fatal and corrupt the
+    interpreter); the FMU's binary turns it into fmi2Error from fmi2ExitInitializationMode,
+    and the message reaches the importer's logger even with debug logging off."""
     with pytest.raises(FMICallException) as info:
-        runner.step(np.zeros(6), 1 / FS)
-    assert info.value.status == 2  # fmi2Discard
+        FmuRunner(fmu_dir / "AttitudeEstimator.fmu", parameters, INPUTS, OUTPUTS, logging=False)
+    assert info.value.status == 3  # fmi2Error
     log = capsys.readouterr().out
     assert "[ERROR] invalid parameter" in log and message in log, log
+
+
+def test_fmi_status_follows_the_log_and_reset_clears_an_error(fmu_dir, recording, capsys):
+    """A step that logs a warning returns fmi2Warning; after an fmi2Error, fmi2Reset and valid
+    parameters give a working instance again."""
+    runner = _estimator(fmu_dir)
+    runner.fmu.setReal(runner.input_vr, [math.nan] * 6)
+    status = runner.fmu.fmi2DoStep(runner.fmu.component, 0.0, 1 / FS, 1)
+    assert status == 1  # fmi2Warning: "non-finite input; estimate held"
+    runner.fmu.reset()
+    runner.parameters = {"delta_n": -1.0}
+    with pytest.raises(FMICallException) as info:
+        runner._initialise()
+    assert info.value.status == 3
+    runner.fmu.reset()
+    runner.parameters = {}
+    runner._initialise()
+    gyr, acc = recording
+    out, valid = runner.run(np.hstack([gyr, acc])[:100], 1 / FS)
     runner.close()
+    assert valid.all() and np.abs(out[:, :4] - estimate(gyr[:100], acc[:100], FS).quat).max() < 1e-9
+    assert "non-finite input" in capsys.readouterr().out
 
 
 def test_non_finite_inputs_hold_the_estimate_and_clear_valid(fmu_dir, recording, capsys):
@@ -249,3 +270,12 @@ def test_verify_cli_json_contract_and_exit_status(fmu_dir, monkeypatch, capsys):
     monkeypatch.setitem(verify_module.SCENARIOS, "incline", verify_module.Scenario(60.0, "mean"))
     assert main(args) == 2
     assert "too short" in capsys.readouterr().err
+
+
+def test_without_a_c_compiler_the_build_warns_and_keeps_pythonfmus_binary(tmp_path, monkeypatch):
+    from systems.fmu_build import compile_guard
+
+    monkeypatch.setenv("CC", str(tmp_path / "no-such-cc"))
+    said = []
+    assert compile_guard(tmp_path / "guard.so", log=said.append) is None
+    assert "cannot compile fmi2_guard.c" in said[0] and "fmi2Discard instead of fmi2Error" in said[0]

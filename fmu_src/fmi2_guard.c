@@ -1,0 +1,236 @@
+/* fmi2_guard.c: the FMI 2.0 co-simulation entry points of the project's FMUs.
+ *
+ * pythonfmu's export library runs the Python model, but it cannot end a call in fmi2Error:
+ * a Python exception becomes fmi2Fatal (and corrupts the embedded interpreter), and it
+ * passes no log message on unless the importer switched debug logging on. This library is
+ * the FMU's binary; it loads pythonfmu's library (PYTHONFMU_LIBRARY, beside it in the same
+ * binaries/<platform> folder), forwards every call, and applies the FMI 2.0 meaning of the
+ * status codes:
+ *
+ *   - a call during which the model logged a warning returns at least fmi2Warning, one that
+ *     logged an error at least fmi2Error (the model logs, never raises: fmu_support.fail);
+ *   - warnings and errors always reach the importer's logger; messages of status fmi2OK only
+ *     with debug logging on, filtered by the categories of fmi2SetDebugLogging.
+ */
+#define _GNU_SOURCE
+#include <dlfcn.h>
+#include <pthread.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define PYTHONFMU_LIBRARY "pythonfmu-export.so"
+
+/* FMI 2.0 types (fmi2TypesPlatform.h, fmi2FunctionTypes.h) */
+typedef void *fmi2Component;
+typedef void *fmi2ComponentEnvironment;
+typedef void *fmi2FMUstate;
+typedef unsigned int fmi2ValueReference;
+typedef double fmi2Real;
+typedef int fmi2Integer;
+typedef int fmi2Boolean;
+typedef const char *fmi2String;
+typedef char fmi2Byte;
+typedef enum { fmi2OK, fmi2Warning, fmi2Discard, fmi2Error, fmi2Fatal, fmi2Pending } fmi2Status;
+typedef enum { fmi2ModelExchange, fmi2CoSimulation } fmi2Type;
+typedef enum { fmi2DoStepStatus, fmi2PendingStatus, fmi2LastSuccessfulTime, fmi2Terminated } fmi2StatusKind;
+typedef void (*fmi2CallbackLogger)(fmi2ComponentEnvironment, fmi2String, fmi2Status, fmi2String, fmi2String, ...);
+typedef struct {
+    fmi2CallbackLogger logger;
+    void *(*allocateMemory)(size_t, size_t);
+    void (*freeMemory)(void *);
+    void (*stepFinished)(fmi2ComponentEnvironment, fmi2Status);
+    fmi2ComponentEnvironment componentEnvironment;
+} fmi2CallbackFunctions;
+
+#define EXPORT __attribute__((visibility("default")))
+
+/* every entry point: return type, name, parameter list, argument list */
+#define FMI2_CALLS(X)                                                                                              \
+    X(fmi2Status, fmi2SetupExperiment, (fmi2Component c, fmi2Boolean td, fmi2Real tol, fmi2Real t0, fmi2Boolean sd, \
+                                        fmi2Real t1), (c, td, tol, t0, sd, t1))                                     \
+    X(fmi2Status, fmi2EnterInitializationMode, (fmi2Component c), (c))                                             \
+    X(fmi2Status, fmi2ExitInitializationMode, (fmi2Component c), (c))                                              \
+    X(fmi2Status, fmi2Terminate, (fmi2Component c), (c))                                                           \
+    X(fmi2Status, fmi2Reset, (fmi2Component c), (c))                                                               \
+    X(fmi2Status, fmi2GetReal, (fmi2Component c, const fmi2ValueReference *vr, size_t n, fmi2Real *v), (c, vr, n, v)) \
+    X(fmi2Status, fmi2GetInteger, (fmi2Component c, const fmi2ValueReference *vr, size_t n, fmi2Integer *v),        \
+      (c, vr, n, v))                                                                                               \
+    X(fmi2Status, fmi2GetBoolean, (fmi2Component c, const fmi2ValueReference *vr, size_t n, fmi2Boolean *v),        \
+      (c, vr, n, v))                                                                                               \
+    X(fmi2Status, fmi2GetString, (fmi2Component c, const fmi2ValueReference *vr, size_t n, fmi2String *v),          \
+      (c, vr, n, v))                                                                                               \
+    X(fmi2Status, fmi2SetReal, (fmi2Component c, const fmi2ValueReference *vr, size_t n, const fmi2Real *v),        \
+      (c, vr, n, v))                                                                                               \
+    X(fmi2Status, fmi2SetInteger, (fmi2Component c, const fmi2ValueReference *vr, size_t n, const fmi2Integer *v),  \
+      (c, vr, n, v))                                                                                               \
+    X(fmi2Status, fmi2SetBoolean, (fmi2Component c, const fmi2ValueReference *vr, size_t n, const fmi2Boolean *v),  \
+      (c, vr, n, v))                                                                                               \
+    X(fmi2Status, fmi2SetString, (fmi2Component c, const fmi2ValueReference *vr, size_t n, const fmi2String *v),    \
+      (c, vr, n, v))                                                                                               \
+    X(fmi2Status, fmi2GetFMUstate, (fmi2Component c, fmi2FMUstate *s), (c, s))                                     \
+    X(fmi2Status, fmi2SetFMUstate, (fmi2Component c, fmi2FMUstate s), (c, s))                                      \
+    X(fmi2Status, fmi2FreeFMUstate, (fmi2Component c, fmi2FMUstate *s), (c, s))                                    \
+    X(fmi2Status, fmi2SerializedFMUstateSize, (fmi2Component c, fmi2FMUstate s, size_t *n), (c, s, n))             \
+    X(fmi2Status, fmi2SerializeFMUstate, (fmi2Component c, fmi2FMUstate s, fmi2Byte *b, size_t n), (c, s, b, n))   \
+    X(fmi2Status, fmi2DeSerializeFMUstate, (fmi2Component c, const fmi2Byte *b, size_t n, fmi2FMUstate *s),         \
+      (c, b, n, s))                                                                                                \
+    X(fmi2Status, fmi2GetDirectionalDerivative, (fmi2Component c, const fmi2ValueReference *u, size_t nu,           \
+      const fmi2ValueReference *z, size_t nz, const fmi2Real *du, fmi2Real *dz), (c, u, nu, z, nz, du, dz))       \
+    X(fmi2Status, fmi2SetRealInputDerivatives, (fmi2Component c, const fmi2ValueReference *vr, size_t n,            \
+      const fmi2Integer *order, const fmi2Real *v), (c, vr, n, order, v))                                          \
+    X(fmi2Status, fmi2GetRealOutputDerivatives, (fmi2Component c, const fmi2ValueReference *vr, size_t n,           \
+      const fmi2Integer *order, fmi2Real *v), (c, vr, n, order, v))                                                \
+    X(fmi2Status, fmi2DoStep, (fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean keep), (c, t, h, keep))        \
+    X(fmi2Status, fmi2CancelStep, (fmi2Component c), (c))                                                          \
+    X(fmi2Status, fmi2GetStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Status *v), (c, k, v))              \
+    X(fmi2Status, fmi2GetRealStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Real *v), (c, k, v))            \
+    X(fmi2Status, fmi2GetIntegerStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Integer *v), (c, k, v))      \
+    X(fmi2Status, fmi2GetBooleanStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Boolean *v), (c, k, v))      \
+    X(fmi2Status, fmi2GetStringStatus, (fmi2Component c, const fmi2StatusKind k, fmi2String *v), (c, k, v))
+
+/* pythonfmu's entry points, loaded once */
+static struct {
+    fmi2Component (*fmi2Instantiate)(fmi2String, fmi2Type, fmi2String, fmi2String, const fmi2CallbackFunctions *,
+                                     fmi2Boolean, fmi2Boolean);
+    void (*fmi2FreeInstance)(fmi2Component);
+#define MEMBER(ret, name, params, args) ret(*name) params;
+    FMI2_CALLS(MEMBER)
+#undef MEMBER
+} inner;
+static const char *load_error = "not loaded";
+static pthread_once_t load_once = PTHREAD_ONCE_INIT;
+
+static void load_inner(void) {
+    static char path[4096], message[4352];
+    Dl_info self;
+    if (!dladdr((void *)&load_inner, &self) || !self.dli_fname) {
+        load_error = "cannot locate the FMU's own library";
+        return;
+    }
+    const char *slash = strrchr(self.dli_fname, '/');
+    int dir = slash ? (int)(slash - self.dli_fname) : 0;
+    snprintf(path, sizeof path, "%.*s%s" PYTHONFMU_LIBRARY, dir, self.dli_fname, slash ? "/" : "");
+    /* never unloaded: pythonfmu finalises its embedded Python when its library goes */
+    void *lib = dlopen(path, RTLD_NOW | RTLD_LOCAL | RTLD_NODELETE);
+    if (!lib) {
+        snprintf(message, sizeof message, "cannot load %s: %s", path, dlerror());
+        load_error = message;
+        return;
+    }
+#define LOAD(name)                                                                                                 \
+    if (!(*(void **)&inner.name = dlsym(lib, #name))) {                                                            \
+        snprintf(message, sizeof message, "%s has no %s", path, #name);                                           \
+        load_error = message;                                                                                      \
+        return;                                                                                                    \
+    }
+#define LOAD_CALL(ret, name, params, args) LOAD(name)
+    LOAD(fmi2Instantiate)
+    LOAD(fmi2FreeInstance)
+    FMI2_CALLS(LOAD_CALL)
+#undef LOAD_CALL
+#undef LOAD
+    load_error = NULL;
+}
+
+typedef struct {
+    fmi2Component model;           /* pythonfmu's instance */
+    fmi2CallbackFunctions user;    /* the importer's callbacks */
+    fmi2CallbackFunctions relayed; /* what pythonfmu gets: relay() as logger, this guard as environment */
+    fmi2Status logged;             /* the most severe warning or error logged during the current call */
+    int debug;                     /* debug logging on (fmi2Instantiate / fmi2SetDebugLogging) */
+    size_t n_categories;           /* 0: every category */
+    char **categories;
+} Guard;
+
+static int wanted(const Guard *g, fmi2String category) {
+    if (!g->debug) return 0;
+    if (g->n_categories == 0) return 1;
+    for (size_t i = 0; i < g->n_categories; i++)
+        if (category && strcmp(category, g->categories[i]) == 0) return 1;
+    return 0;
+}
+
+static void relay(fmi2ComponentEnvironment env, fmi2String name, fmi2Status status, fmi2String category,
+                  fmi2String message, ...) {
+    Guard *g = env;
+    int severe = status == fmi2Warning || status == fmi2Error || status == fmi2Fatal;
+    if (severe && status > g->logged) g->logged = status;
+    if (!g->user.logger || !(severe || wanted(g, category))) return;
+    char text[4096], escaped[8192];
+    va_list args;
+    va_start(args, message);
+    vsnprintf(text, sizeof text, message ? message : "", args);
+    va_end(args);
+    size_t j = 0; /* the importer's logger reads the message as a format */
+    for (size_t i = 0; text[i] && j + 2 < sizeof escaped; i++) {
+        if (text[i] == '%') escaped[j++] = '%';
+        escaped[j++] = text[i];
+    }
+    escaped[j] = '\0';
+    g->user.logger(g->user.componentEnvironment, name, status, category, escaped);
+}
+
+static void set_categories(Guard *g, size_t n, const fmi2String *categories) {
+    for (size_t i = 0; i < g->n_categories; i++) free(g->categories[i]);
+    free(g->categories);
+    g->categories = n ? calloc(n, sizeof *g->categories) : NULL;
+    g->n_categories = g->categories ? n : 0;
+    for (size_t i = 0; i < g->n_categories; i++) g->categories[i] = strdup(categories[i] ? categories[i] : "");
+}
+
+EXPORT const char *fmi2GetTypesPlatform(void) { return "default"; }
+EXPORT const char *fmi2GetVersion(void) { return "2.0"; }
+
+EXPORT fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String guid,
+                                     fmi2String resources, const fmi2CallbackFunctions *functions,
+                                     fmi2Boolean visible, fmi2Boolean loggingOn) {
+    pthread_once(&load_once, load_inner);
+    if (load_error) {
+        if (functions && functions->logger)
+            functions->logger(functions->componentEnvironment, instanceName, fmi2Fatal, "logStatusFatal", "%s",
+                              load_error);
+        return NULL;
+    }
+    Guard *g = calloc(1, sizeof *g);
+    if (!g) return NULL;
+    if (functions) g->user = *functions;
+    g->relayed = g->user;
+    g->relayed.logger = relay;
+    g->relayed.componentEnvironment = g;
+    g->debug = loggingOn;
+    /* pythonfmu drops every message without debug logging: it always gets it, relay() filters */
+    g->model = inner.fmi2Instantiate(instanceName, fmuType, guid, resources, &g->relayed, visible, 1);
+    if (!g->model) {
+        free(g);
+        return NULL;
+    }
+    return g;
+}
+
+EXPORT void fmi2FreeInstance(fmi2Component c) {
+    Guard *g = c;
+    if (!g) return;
+    inner.fmi2FreeInstance(g->model);
+    set_categories(g, 0, NULL);
+    free(g);
+}
+
+EXPORT fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t n, const fmi2String *categories) {
+    Guard *g = c;
+    g->debug = loggingOn;
+    set_categories(g, n, categories);
+    return fmi2OK;
+}
+
+#define FORWARD(ret, name, params, args)                                                                           \
+    EXPORT ret name params {                                                                                       \
+        Guard *g = c;                                                                                              \
+        g->logged = fmi2OK;                                                                                        \
+        c = g->model;                                                                                              \
+        fmi2Status status = inner.name args;                                                                       \
+        return status > g->logged ? status : g->logged;                                                            \
+    }
+FMI2_CALLS(FORWARD)
+#undef FORWARD
