@@ -152,24 +152,31 @@ static int wanted(const Guard *g, fmi2String category) {
     return 0;
 }
 
+/* pass text on to the importer's logger, which reads the message as a printf format */
+static void deliver(const fmi2CallbackFunctions *f, fmi2String name, fmi2Status status, fmi2String category,
+                    const char *text) {
+    char escaped[8192];
+    size_t j = 0;
+    for (size_t i = 0; text[i] && j + 2 < sizeof escaped; i++) {
+        if (text[i] == '%') escaped[j++] = '%';
+        escaped[j++] = text[i];
+    }
+    escaped[j] = '\0';
+    f->logger(f->componentEnvironment, name, status, category, escaped);
+}
+
 static void relay(fmi2ComponentEnvironment env, fmi2String name, fmi2Status status, fmi2String category,
                   fmi2String message, ...) {
     Guard *g = env;
     int severe = status == fmi2Warning || status == fmi2Error || status == fmi2Fatal;
     if (severe && status > g->logged) g->logged = status;
     if (!g->user.logger || !(severe || wanted(g, category))) return;
-    char text[4096], escaped[8192];
+    char text[4096];
     va_list args;
     va_start(args, message);
     vsnprintf(text, sizeof text, message ? message : "", args);
     va_end(args);
-    size_t j = 0; /* the importer's logger reads the message as a format */
-    for (size_t i = 0; text[i] && j + 2 < sizeof escaped; i++) {
-        if (text[i] == '%') escaped[j++] = '%';
-        escaped[j++] = text[i];
-    }
-    escaped[j] = '\0';
-    g->user.logger(g->user.componentEnvironment, name, status, category, escaped);
+    deliver(&g->user, name, status, category, text);
 }
 
 static void set_categories(Guard *g, size_t n, const fmi2String *categories) {
@@ -188,9 +195,7 @@ EXPORT fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, 
                                      fmi2Boolean visible, fmi2Boolean loggingOn) {
     pthread_once(&load_once, load_inner);
     if (load_error) {
-        if (functions && functions->logger)
-            functions->logger(functions->componentEnvironment, instanceName, fmi2Fatal, "logStatusFatal", "%s",
-                              load_error);
+        if (functions && functions->logger) deliver(functions, instanceName, fmi2Fatal, "logStatusFatal", load_error);
         return NULL;
     }
     Guard *g = calloc(1, sizeof *g);

@@ -279,3 +279,23 @@ def test_without_a_c_compiler_the_build_warns_and_keeps_pythonfmus_binary(tmp_pa
     said = []
     assert compile_guard(tmp_path / "guard.so", log=said.append) is None
     assert "cannot compile fmi2_guard.c" in said[0] and "fmi2Discard instead of fmi2Error" in said[0]
+
+
+def test_guard_reports_a_missing_pythonfmu_library_instead_of_crashing(fmu_dir, tmp_path, capsys):
+    import zipfile
+
+    from fmpy import extract, read_model_description
+
+    from systems.cosim import load_slave
+    from systems.fmu_build import PYTHONFMU_LIBRARY
+
+    broken = tmp_path / "AttitudeEstimator.fmu"
+    with zipfile.ZipFile(fmu_dir / "AttitudeEstimator.fmu") as src, zipfile.ZipFile(broken, "w") as dst:
+        for item in src.infolist():
+            if not item.filename.endswith(PYTHONFMU_LIBRARY):
+                dst.writestr(item, src.read(item))
+    md = read_model_description(str(broken))
+    slave = load_slave(md, extract(str(broken), str(tmp_path / "x")), "broken")
+    with pytest.raises(Exception, match="instantiate"):
+        slave.instantiate()
+    assert f"cannot load {tmp_path / 'x'}" in capsys.readouterr().out
