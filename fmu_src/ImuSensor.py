@@ -41,9 +41,9 @@ class ImuSensor(ProjectSlave):
                 gyr_offset=(self.gyr_offset_x, self.gyr_offset_y, self.gyr_offset_z),
                 acc_offset=(self.acc_offset_x, self.acc_offset_y, self.acc_offset_z),
             )
+            self.rng = np.random.default_rng(self.seed)
         except ValueError as exc:
             self.fail(f"invalid parameter: {exc}")
-        self.rng = np.random.default_rng(self.seed)
 
     def do_step(self, current_time, step_size):
         if self.error is not None:

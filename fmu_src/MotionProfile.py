@@ -37,10 +37,9 @@ class MotionProfile(ProjectSlave):
             prof = profile(self.profile)
             overrides = {p.name: getattr(self, f"{prof.name}_{p.name}") for p in prof.params}
             motion = prof.motion({k: v for k, v in overrides.items() if v != 0.0}, g=self.g)
+            self.stream = motion.stream(self.seed)
         except ValueError as exc:
             self.fail(f"invalid parameter: {exc}")
-            return
-        self.stream = motion.stream(self.seed)
 
     def do_step(self, current_time, step_size):
         if self.error is not None:

@@ -137,6 +137,20 @@ def test_invalid_parameter_ends_initialisation_in_fmi2_error(fmu_dir, parameters
     assert "[ERROR] invalid parameter" in log and message in log, log
 
 
+@pytest.mark.parametrize("name, parameters, message", [
+    ("ImuSensor", {"delta_n": -1.0}, "delta_n"),
+    ("ImuSensor", {"seed": -3}, "negative"),
+    ("MotionProfile", {"profile": "jogging"}, "jogging"),
+    ("MotionProfile", {"seed": -3}, "negative"),
+])
+def test_invalid_parameters_of_the_other_fmus_end_in_fmi2_error(fmu_dir, name, parameters, message, capsys):
+    with pytest.raises(FMICallException) as info:
+        FmuRunner(fmu_dir / f"{name}.fmu", parameters)
+    assert info.value.status == 3
+    log = capsys.readouterr().out
+    assert "[ERROR] invalid parameter" in log and message in log, log
+
+
 def test_fmi_status_follows_the_log_and_reset_clears_an_error(fmu_dir, recording, capsys):
     """A step that logs a warning returns fmi2Warning; after an fmi2Error, fmi2Reset and valid
     parameters give a working instance again."""
