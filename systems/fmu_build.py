@@ -3,8 +3,8 @@
 Each FMU carries fmu_src/fmu_support.py and the packages blocks/ and systems/ in its
 resources, so it runs where only numpy, scipy, control and pythonfmu are installed.
 
-On Linux and macOS the FMU's binary is fmu_src/fmi2_guard.c, compiled here with the C
-compiler ($CC, else Python's, else cc); it loads pythonfmu's library from beside it and
+On Linux (and macOS, not yet tried there) the FMU's binary is fmu_src/fmi2_guard.c,
+compiled here with the C compiler ($CC, else Python's, else cc); it loads pythonfmu's library from beside it and
 gives the FMI status codes their meaning (a logged error ends the call in fmi2Error).
 Without a compiler the FMUs keep pythonfmu's binary, and a warning says what that costs.
 """
