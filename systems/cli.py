@@ -7,6 +7,7 @@ import os
 import sys
 
 from blocks.methods import METHODS
+from blocks.methods import method as known_method
 
 EXIT_BAD_INPUT = 2
 EXIT_CHECK_FAILED = 1
@@ -189,8 +190,7 @@ def cmd_verify(args) -> int:
         if name not in SCENARIOS:
             raise ValueError(f"unknown profile {name!r}; verified profiles: {', '.join(SCENARIOS)}")
     for name in args.method or []:
-        if name not in METHODS:
-            raise ValueError(f"unknown method {name!r}; available: {', '.join(METHODS)}")
+        known_method(name)  # refuses unknown names
     fmu_dir = ensure_built(args.fmu_dir, args.rebuild, log=lambda m: print(f"attitude: {m}", file=sys.stderr))
     rows = verify(fmu_dir, args.profile, args.method)
     if args.json:
@@ -212,11 +212,10 @@ def cmd_verify(args) -> int:
 
 def cmd_compare(args) -> int:
     from .compare import compare
-    from .motion import PROFILES
+    from .motion import profile as known_profile
 
     for name in args.profile or []:
-        if name not in PROFILES:
-            raise ValueError(f"unknown profile {name!r}; available: {', '.join(PROFILES)}")
+        known_profile(name)  # refuses unknown names
     result = compare(args.profile)
     if args.json:
         print(json.dumps(result, indent=2))

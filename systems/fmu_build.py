@@ -59,9 +59,14 @@ GUARD_PLATFORMS = {"linux": "linux64", "darwin": "darwin64"}  # sys.platform pre
 PYTHONFMU_LIBRARY = "pythonfmu-export.so"  # the name fmi2_guard.c loads
 
 
+def guard_platform() -> str | None:
+    """The FMI binaries folder the guard is built for on this machine; None: no guard here."""
+    return next((v for k, v in GUARD_PLATFORMS.items() if sys.platform.startswith(k)), None)
+
+
 def compile_guard(out: Path, log=lambda m: print(m, file=sys.stderr)) -> Path | None:
     """Compile fmi2_guard.c into the shared library out; None (with a warning) where it cannot be."""
-    platform = next((v for k, v in GUARD_PLATFORMS.items() if sys.platform.startswith(k)), None)
+    platform = guard_platform()
     cc = shlex.split(os.environ.get("CC") or sysconfig.get_config_var("CC") or "cc")
     command = [*cc, "-shared", "-fPIC", "-O2", "-fvisibility=hidden", "-o", str(out),
                str(SOURCE_DIR / "fmi2_guard.c"), "-ldl", "-lpthread"]
@@ -81,7 +86,7 @@ def compile_guard(out: Path, log=lambda m: print(m, file=sys.stderr)) -> Path | 
 
 def install_guard(fmu: Path, guard: Path) -> None:
     """Make guard the FMU's binary for this platform, pythonfmu's library its PYTHONFMU_LIBRARY."""
-    platform = next(v for k, v in GUARD_PLATFORMS.items() if sys.platform.startswith(k))
+    platform = guard_platform()
     suffix = ".dylib" if platform == "darwin64" else ".so"
     binary = f"binaries/{platform}/{fmu.stem}{suffix}"
     staged = fmu.with_suffix(".guarded")
