@@ -147,3 +147,26 @@ def test_bode_writes_a_png(tmp_path):
     with pytest.raises(SystemExit) as refused:  # argparse: not an LTI filter
         main(["bode", "--method", "luinge", "--out", str(out)])
     assert refused.value.code == 2
+
+
+def test_wiener_is_vqf_core_at_the_matching_break_frequency():
+    """vqf low-passes the accelerometer in the gyro-integrated frame with a second-order
+    Butterworth of time constant tau_acc: Rizun's filter (eq. 34) at omega_g = √2/tau_acc.
+    With vqf's bias estimation off the two agree on the same samples, and the agreement
+    is specific to that break frequency."""
+    vqf = pytest.importorskip("vqf")
+    motion = profile("human").motion().generate(200.0, FS, seed=3)
+    gyr, acc = IMU.apply(motion, seed=4)
+    tau = 3.0  # s, vqf's default
+    q = vqf.VQF(1 / FS, tauAcc=tau, motionBiasEstEnabled=False, restBiasEstEnabled=False).updateBatch(gyr, acc)
+    up_vqf = Rotation.from_quat(q["quat6D"], scalar_first=True).inv().apply([0.0, 0.0, 1.0])
+    settled = slice(int(15 * tau * FS), None)  # both start-ups forgotten (vqf starts on a mean)
+
+    def rms_difference(omega_g):
+        up = estimate(gyr, acc, FS, "wiener", {"omega_g": omega_g}).up
+        return rms(np.degrees(inclination_error(up[settled], up_vqf[settled])))
+
+    truth_error = rms(np.degrees(inclination_error(up_vqf[settled], motion.up[settled])))
+    assert truth_error > 0.5  # vigorous motion: both are far from the truth ...
+    assert rms_difference(math.sqrt(2) / tau) < 0.05  # ... and from each other by far less
+    assert rms_difference(1.2 * math.sqrt(2) / tau) > 0.2

@@ -1,6 +1,6 @@
 """Real-recording tools: the offline Wiener smoother, the gyro-offset estimator and
 `attitude evaluate` (on small synthetic recordings written here; the BROAD run is a
-benchmark, tests/test_broad_benchmark.py)."""
+benchmark, tests/test_broad_benchmark.py, that skips without the files)."""
 import json
 import math
 
