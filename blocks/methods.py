@@ -18,7 +18,7 @@ import control
 import numpy as np
 
 from . import earth_filters as ef
-from . import luinge, mahony, tseng, tseng_adaptive
+from . import luinge, mahony, tseng, tseng_adaptive, wiener_local
 from .sensor_frame import DiscreteFilter, SensorFrameStepper
 from .stepper_system import stepper_system
 
@@ -53,13 +53,15 @@ def resolve_params(params: tuple[Param, ...], overrides: Mapping[str, float] | N
 @dataclass(frozen=True)
 class Method:
     """design gives the earth-frame filter of a sensor-frame method; kernel is the module
-    of a method with a step of its own (exactly one of the two)."""
+    of a method with a step of its own. A method with both steps with its kernel when
+    uses_kernel(resolved params) is true, with its earth-frame filter otherwise."""
 
     name: str
     summary: str
     params: tuple[Param, ...]
     design: Callable[[Mapping[str, float | None]], control.TransferFunction] | None = None
     kernel: object = None
+    uses_kernel: Callable[[Mapping[str, float | None]], bool] = lambda p: True
 
     def resolve(self, overrides: Mapping[str, float] | None = None) -> dict[str, float | None]:
         """Defaults updated by overrides; unknown names and non-positive values are refused."""
@@ -76,15 +78,35 @@ class Method:
         return self.design(self.resolve(overrides))
 
 
+NOMINAL_DELTA_V = 1.0  # m/s/√Hz: vigorous human motion (Rizun's Table 1), when delta_v is unset
 NOISE_PARAMS = (
     Param("delta_n", math.radians(0.1), "rad/s/√Hz", "gyro noise density, one-sided (datasheet)"),
-    Param("delta_v", 1.0, "m/s/√Hz", "slosh: density of the velocity of the motion (eq. 14)"),
+    Param("delta_v", None, "m/s/√Hz",
+          f"slosh: density of the velocity of the motion (eq. 14); unset: {NOMINAL_DELTA_V:g} for the stationary filter"),
     Param("g", ef.STANDARD_GRAVITY, "m/s²", "magnitude of gravity"),
+)
+LOCAL_NOISE_PARAMS = (
+    Param("stationary", 0.0, "1", "0: omega_g from noise densities measured over the last tau_noise s "
+          "(blocks.wiener_local); 1, or omega_g, omega_c or delta_v given: the stationary filter", True),
+    Param("scale_error", 0.005, "1", "rms of each element of the gyro's scale-factor and misalignment "
+          "error (datasheet)", True),
+    Param("omega_m", 10.0, "rad/s", "band limit of the motion (velocity and rate) in the local densities"),
+    Param("tau_noise", 1.0, "s", "averaging time of the local densities"),
+    Param("tau_v", 1.0, "s", "time constant of the high-pass on the velocity residual"),
+    Param("delta_v_min", 0.01, "m/s/√Hz", "floor of the local slosh density (rest)"),
 )
 
 
 def _omega_g(p: Mapping[str, float | None]) -> float:
-    return p["omega_g"] if p["omega_g"] is not None else ef.omega_g(p["delta_n"], p["delta_v"], p["g"])
+    if p["omega_g"] is not None:
+        return p["omega_g"]
+    return ef.omega_g(p["delta_n"], p["delta_v"] if p["delta_v"] is not None else NOMINAL_DELTA_V, p["g"])
+
+
+def _wiener_is_local(p: Mapping[str, float | None]) -> bool:
+    if p["stationary"] not in (0.0, 1.0):
+        raise ValueError(f"parameter stationary must be 0 or 1, got {p['stationary']!r}")
+    return p["stationary"] == 0.0 and p["omega_g"] is None and p["omega_c"] is None and p["delta_v"] is None
 
 
 def _design_wiener(p):
@@ -101,12 +123,15 @@ def _design_first_order(p):
 METHODS: dict[str, Method] = {
     "wiener": Method(
         "wiener",
-        "Rizun's optimal Wiener filter: eq. 34 (Butterworth), or eq. 33 when omega_c is given",
+        "Rizun's optimal Wiener filter: eq. 34 (Butterworth) with omega_g from local noise densities; "
+        "with stationary=1 eq. 34 at fixed densities, or eq. 33 when omega_c is given",
         NOISE_PARAMS + (
             Param("omega_g", None, "rad/s", "break frequency; default sqrt(g·delta_n/delta_v), eq. 25"),
             Param("omega_c", None, "rad/s", "band limit of the motion; given, eq. 33 replaces eq. 34"),
-        ),
+        ) + LOCAL_NOISE_PARAMS,
         _design_wiener,
+        kernel=wiener_local,
+        uses_kernel=_wiener_is_local,
     ),
     "tseng": Method(
         "tseng",
@@ -189,11 +214,12 @@ class KernelStepper:
 def stepper(name: str, params: tuple, Ts: float):
     """The stepper of method name for params ((name, value) pairs) at sample time Ts (s)."""
     m = method(name)
-    if m.is_sensor_frame:
+    resolved = m.resolve(dict(params))
+    if m.kernel is None or not m.uses_kernel(resolved):
         return SensorFrameStepper(discrete_filter(name, params, Ts))
     if not (math.isfinite(Ts) and Ts > 0):
         raise ValueError(f"sample time Ts must be a finite positive number of seconds, got {Ts!r}")
-    return KernelStepper(m.kernel, m.kernel.coefficients(m.resolve(dict(params)), Ts))
+    return KernelStepper(m.kernel, m.kernel.coefficients(resolved, Ts))
 
 
 def estimator_system(name: str, params: Mapping[str, float] | None = None, dt: float = 0.01,

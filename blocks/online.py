@@ -12,9 +12,9 @@ from .heading import heading_step
 from .heading import initial_state as heading_initial_state
 from .heading import resolve as heading_resolve
 from .jit import kernel
-from .methods import method as get_method, stepper
+from .methods import stepper
 from .quaternion import quat_euler_zyx
-from .sensor_frame import sensor_frame_step, start_gravity
+from .sensor_frame import SensorFrameStepper, sensor_frame_step, start_gravity
 
 IO_INPUTS = slice(0, 6)  # gyr x, y, z (rad/s), acc x, y, z (m/s²)
 IO_OUTPUTS = slice(6, 16)  # q w, x, y, z; unit up x, y, z; roll, pitch, yaw (rad)
@@ -74,8 +74,7 @@ class OnlineEstimator:
     """
 
     def __init__(self, method: str = "wiener", params: Mapping[str, float] | None = None, heading: bool = False):
-        get_method(method).resolve(params)  # refuse unknown methods and bad parameters now
-        self.sensor_frame = get_method(method).is_sensor_frame
+        stepper(method, tuple(sorted((params or {}).items())), 1.0)  # refuse bad methods and parameters now
         self.method = method
         self.params = tuple(sorted((params or {}).items()))
         self.heading = heading
@@ -109,6 +108,7 @@ class OnlineEstimator:
             if not (math.isfinite(Ts) and Ts > 0):
                 raise ValueError(f"sample time must be a finite positive number of seconds, got {Ts!r}")
             self._stepper, self._Ts = stepper(self.method, self.params, Ts), Ts
+            self.sensor_frame = isinstance(self._stepper, SensorFrameStepper)
             self._heading_coef = heading_coefficients(heading_resolve(), Ts)
 
         if self.state is None:

@@ -78,20 +78,22 @@ class DiscreteFilter:
 
 
 @kernel(inline=True)
-def sensor_frame_step(X, q, gyr, acc, k, Ad, Bd, C, D, Ts, Xr, g_out):
-    """Sample k: rotate the state rows by −ω̂·Ts, apply the ZOH filter, output ĝ.
-
-    X (n×3) and q (4, sensor → earth) are updated in place; g_out[k] receives ĝ (m/s²).
-    q integrates the gyro and is levelled each sample so that q rotates ĝ onto earth up
-    (its heading is integrated gyro). gyr[k] in rad/s is the mean rate over
-    (t[k−1], t[k]], acc[k] in m/s² is taken at t[k]. Xr (n×3) is scratch space.
-    """
-    n = X.shape[0]
+def turn_rows(X, Xr, gyr, k, Ts):
+    """Rows of X (earth-fixed vectors in sensor coordinates) turned into sample k's sensor
+    frame, written to Xr: the exact rotation by −ω̂·Ts for gyr[k] (rad/s) held over
+    (t[k−1], t[k]]. Returns that sample's rotation quaternion."""
     dq = rotvec_quat(gyr[k, 0] * Ts, gyr[k, 1] * Ts, gyr[k, 2] * Ts)
     # a vector fixed in the earth frame turns by the inverse rotation in sensor coordinates
     dq_inv = (dq[0], -dq[1], -dq[2], -dq[3])
-    for j in range(n):
+    for j in range(X.shape[0]):
         Xr[j, 0], Xr[j, 1], Xr[j, 2] = quat_rotate(dq_inv, (X[j, 0], X[j, 1], X[j, 2]))
+    return dq
+
+
+@kernel(inline=True)
+def filter_rows(X, Xr, acc, k, Ad, Bd, C, D, g_out):
+    """The discrete LTI filter per axis: X = Ad·Xr + Bd·acc[k]ᵀ, g_out[k] = C·X + D·acc[k]."""
+    n = Ad.shape[0]
     a0, a1, a2 = acc[k, 0], acc[k, 1], acc[k, 2]
     g0, g1, g2 = D * a0, D * a1, D * a2
     for j in range(n):
@@ -105,12 +107,32 @@ def sensor_frame_step(X, q, gyr, acc, k, Ad, Bd, C, D, Ts, Xr, g_out):
         g1 += C[j] * s1
         g2 += C[j] * s2
     g_out[k, 0], g_out[k, 1], g_out[k, 2] = g0, g1, g2
-    # orientation: integrate the gyro, then level it onto ĝ
+
+
+@kernel(inline=True)
+def level_onto_gravity(q, dq, g_out, k):
+    """Orientation q (sensor → earth, in place): integrate the sample's rotation dq, then
+    level it so that q turns ĝ = g_out[k] onto earth up (heading stays integrated gyro)."""
+    g0, g1, g2 = g_out[k, 0], g_out[k, 1], g_out[k, 2]
     qt = quat_multiply((q[0], q[1], q[2], q[3]), dq)
     norm = math.sqrt(g0 * g0 + g1 * g1 + g2 * g2)
     if norm > 0.0:
         qt = quat_multiply(level_quat(quat_rotate(qt, (g0, g1, g2)), norm), qt)
     q[0], q[1], q[2], q[3] = quat_normalized(qt)
+
+
+@kernel(inline=True)
+def sensor_frame_step(X, q, gyr, acc, k, Ad, Bd, C, D, Ts, Xr, g_out):
+    """Sample k: rotate the state rows by −ω̂·Ts, apply the ZOH filter, output ĝ.
+
+    X (n×3) and q (4, sensor → earth) are updated in place; g_out[k] receives ĝ (m/s²).
+    q integrates the gyro and is levelled each sample so that q rotates ĝ onto earth up
+    (its heading is integrated gyro). gyr[k] in rad/s is the mean rate over
+    (t[k−1], t[k]], acc[k] in m/s² is taken at t[k]. Xr (n×3) is scratch space.
+    """
+    dq = turn_rows(X, Xr, gyr, k, Ts)
+    filter_rows(X, Xr, acc, k, Ad, Bd, C, D, g_out)
+    level_onto_gravity(q, dq, g_out, k)
 
 
 @kernel()

@@ -11,7 +11,7 @@ from scipy.spatial.transform import Rotation
 
 from blocks.gyro_offset import correct as correct_gyro
 from blocks.heading import with_magnetometer
-from blocks.methods import METHODS, method as get_method, stepper
+from blocks.methods import METHODS, KernelStepper, method as get_method, stepper
 from blocks.sensor_frame import start_gravity
 
 
@@ -83,11 +83,35 @@ def estimate(
     if not get_method(method).is_sensor_frame:
         raise ValueError(f"offline smoothing needs an earth-frame filter method "
                          f"({', '.join(n for n, m in METHODS.items() if m.is_sensor_frame)}), not {method!r}")
-    # backward in time: the step from sample k+1 to k turns the frame back by gyr[k+1]
-    gyr_back = np.vstack([np.zeros((1, 3)), -gyr[:0:-1]])
-    backward = _run(step, gyr_back, np.ascontiguousarray(forward.gravity[::-1]), forward.gravity[-1])
-    gravity = backward.gravity[::-1].copy()
+    gyr_back = _backward(gyr)
+    if isinstance(step, KernelStepper):
+        # wiener with local densities: the break frequency of both passes is the lower of the
+        # causal estimates running forward and backward in time
+        omega = np.minimum(_run_local(step, gyr, acc, initial_gravity)[1],
+                           _run_local(step, gyr_back, acc[::-1], acc[-1])[1][::-1])
+        forward = AttitudeEstimate(*_run_local(step, gyr, acc, initial_gravity, omega)[0], offset)
+        backward = _run_local(step, gyr_back, forward.gravity[::-1], forward.gravity[-1], omega[::-1])[0][0]
+    else:
+        backward = _run(step, gyr_back, np.ascontiguousarray(forward.gravity[::-1]), forward.gravity[-1]).gravity
+    gravity = backward[::-1].copy()
     return _with_heading(AttitudeEstimate(gravity, level_onto(forward.quat, gravity), offset), mag, fs)
+
+
+def _backward(gyr) -> np.ndarray:
+    """Gyro for a pass backward in time: the step from sample k+1 to k turns the frame
+    back by gyr[k+1]."""
+    return np.vstack([np.zeros((1, 3)), -gyr[:0:-1]])
+
+
+def _run_local(step, gyr, acc, initial_gravity, omega=None):
+    """((gravity, quat), break frequencies) of blocks.wiener_local over gyr, acc; omega
+    (N, rad/s) imposes the break frequencies."""
+    state = step.initial_state(initial_gravity)
+    acc = np.ascontiguousarray(acc)
+    gravity, quat, used = np.empty_like(acc), np.empty((acc.shape[0], 4)), np.empty(acc.shape[0])
+    imposed = np.empty(0) if omega is None else np.ascontiguousarray(omega)
+    step.module.run_schedule(state, step.coef, np.ascontiguousarray(gyr), acc, gravity, quat, imposed, used)
+    return (gravity, quat), used
 
 
 def _with_heading(est: AttitudeEstimate, mag, fs: float) -> AttitudeEstimate:

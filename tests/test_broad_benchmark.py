@@ -36,6 +36,12 @@ def test_print_the_broad_table(table):
         assert all(math.isfinite(v) for v in row.values())
 
 
+def test_default_wiener_online_is_below_vqf_online(table):
+    """Issue 5, acceptance 1 (online half): defaults from the noise model, no tuning per file."""
+    mean = table["mean"]
+    assert mean["wiener"]["inclination_rmse_deg"] < mean["vqf"]["inclination_rmse_deg"]
+
+
 def test_magnetometer_heading_stays_bounded_in_the_disturbance_trials(table):
     for name in DISTURBED_MAGNETIC:
         if name in table["recordings"]:
