@@ -134,6 +134,7 @@ def run_schedule(state, coef, gyr, acc, gravity, quat, omega_in, omega_out):
         quat[k, 0], quat[k, 1], quat[k, 2], quat[k, 3] = q[0], q[1], q[2], q[3]
 
 
-def run(state, coef, gyr, acc, gravity, quat) -> None:
+@kernel()
+def run(state, coef, gyr, acc, gravity, quat):
     """The kernel-method interface (blocks.methods.KernelStepper): local break frequencies."""
     run_schedule(state, coef, gyr, acc, gravity, quat, np.empty(0), np.empty(gyr.shape[0]))
