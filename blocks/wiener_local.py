@@ -9,10 +9,12 @@ noise model, measured over the last τ seconds (`tau_noise`):
 
 - gyro: δn_eff² = δn² + σ_s²·S_ω(0), where S_ω(0) = 4·⟨|ω|²⟩/ω_m is the low-frequency
   density of an angular rate band-limited (first order) at ω_m (Rizun eq. 14's shape);
-- slosh: δv² = 4·(ω_m + 1/τ_v)/ω_m² · ⟨|v|²⟩/3, with v the velocity residual, the
-  accelerometer minus the gravity estimate integrated in the gyro frame and high-passed
-  at 1/τ_v: the variance such a high-pass leaves of eq. 14's velocity, solved for δv.
-  It is held above delta_v_min (rest).
+- slosh: δv² = ⟨|v|²⟩/(3·J), with v the accelerometer band-passed into a velocity in
+  the gyro frame (minus its own low-pass at 1/τ_v, then integrated with the same leak):
+  gravity and any error of the filter's own estimate are constant or slow there and drop
+  out, so the statistic does not feed back on the filter. J = (1/2π)∫ (ωτ_v)⁴/(1+ω²τ_v²)²
+  /(1+ω²/ω_m²) dω is the variance this band-pass leaves of eq. 14's velocity per unit
+  density. δv is held above delta_v_min (rest).
 
 With σ_s = 0 and a steady motion the estimates settle on the stationary densities and the
 filter on eq. 34. The Butterworth runs in the realisation d/dt[ĝ, u] = ω_g·M·[ĝ, u] +
@@ -26,36 +28,55 @@ import math
 
 import numpy as np
 
+from scipy.integrate import quad
+
+from .earth_filters import butterworth
 from .jit import kernel
 from .sensor_frame import filter_rows, level_onto_gravity, turn_rows
 
 STATE_NAMES = (
     "g_x", "g_y", "g_z",  # gravity estimate ĝ, m/s², sensor coordinates
     "u_x", "u_y", "u_z",  # ω_g·e, e the filter's velocity residual (m/s), so m/s²
-    "v_x", "v_y", "v_z",  # high-passed velocity residual of the noise estimate, m/s
+    "v_x", "v_y", "v_z",  # band-passed velocity of the noise estimate, m/s
+    "f_x", "f_y", "f_z",  # low-passed accelerometer, m/s² (all four rows turn with the gyro)
     "q_w", "q_x", "q_y", "q_z",  # orientation, sensor → earth
     "w2", "v2", "omega_g",  # ⟨|ω|²⟩ (rad²/s²), ⟨|v|²⟩/3 (m²/s²), last break frequency (rad/s)
 )
-ROWS = slice(0, 9)
-QUAT = slice(9, 13)
+ROWS = slice(0, 12)
+QUAT = slice(12, 16)
+W2, V2, OMEGA = 16, 17, 18
 SQRT2 = math.sqrt(2.0)
 
 
 def coefficients(params, Ts: float) -> np.ndarray:
-    """[Ts, g, δn², k_w, k_v, δv_min², a_avg, leak_v]: δn_eff² = δn² + k_w·⟨|ω|²⟩,
-    δv² = k_v·⟨|v|²⟩/3, a_avg = 1 − exp(−Ts/τ), leak_v = exp(−Ts/τ_v)."""
+    """[Ts, g, δn², k_w, 1/J, δv_min², a_avg, leak_v]: δn_eff² = δn² + k_w·⟨|ω|²⟩,
+    δv² = ⟨|v|²⟩/(3·J), a_avg = 1 − exp(−Ts/τ), leak_v = exp(−Ts/τ_v)."""
     wm, tau_v = params["omega_m"], params["tau_v"]
+    c = wm * tau_v
+    J = quad(lambda x: x**4 / ((1.0 + x * x) ** 2 * (1.0 + (x / c) ** 2)), 0.0, np.inf)[0] / (2.0 * math.pi * tau_v)
     return np.array([
-        Ts, params["g"], params["delta_n"] ** 2, 4.0 * params["scale_error"] ** 2 / wm,
-        4.0 * (wm + 1.0 / tau_v) / wm**2, params["delta_v_min"] ** 2,
-        1.0 - math.exp(-Ts / params["tau_noise"]), math.exp(-Ts / tau_v),
+        Ts, params["g"], params["delta_n"] ** 2, 4.0 * params["scale_error"] ** 2 / wm, 1.0 / J,
+        params["delta_v_min"] ** 2, 1.0 - math.exp(-Ts / params["tau_noise"]), math.exp(-Ts / tau_v),
     ])
 
 
+def settled_filter(params, rate_ms: float, delta_v: float):
+    """Eq. 34 at the break frequency the local densities settle on for stationary motion
+    of mean-square angular rate rate_ms (rad²/s², all axes together) and slosh delta_v
+    (m/s/√Hz, eq. 14 band-limited at omega_m): the filter whose eq. 41 error the local
+    filter has on such motion (tests/test_wiener_local.py)."""
+    dn2 = params["delta_n"] ** 2 + 4.0 * params["scale_error"] ** 2 / params["omega_m"] * rate_ms
+    dv2 = max(delta_v**2, params["delta_v_min"] ** 2)
+    return butterworth(math.sqrt(params["g"] * math.sqrt(dn2 / dv2)))
+
+
 def initial_state(coef, acc0) -> np.ndarray:
-    """At rest on acc0 (m/s²): ĝ = acc0, no residuals, q = identity, no motion seen yet."""
+    """At rest on acc0 (m/s²): ĝ along acc0 with the magnitude g (coef[1]), no residuals,
+    q = identity, no motion seen yet."""
     state = np.zeros(len(STATE_NAMES))
-    state[0:3] = acc0
+    norm = float(np.linalg.norm(acc0))
+    state[0:3] = acc0 * (coef[1] / norm) if norm > 0.0 else (0.0, 0.0, coef[1])
+    state[9:12] = acc0
     state[QUAT] = (1.0, 0.0, 0.0, 0.0)
     return state
 
@@ -90,19 +111,20 @@ def butterworth_zoh(wt, Ad, Bd):
 @kernel(inline=True)
 def local_omega_g(state, coef, gyr, acc, k, turned):
     """Update the running densities with sample k (turned: the state rows in this sample's
-    frame) and return ω_g = √(g·δn_eff/δv), rad/s. Writes the new velocity residual into
-    turned[2]."""
-    Ts, g, dn2, k_w, k_v, dv2_min, a_avg, leak = (
+    frame, whose rows 2 and 3, v and the low-passed accelerometer, are updated here) and
+    return ω_g = √(g·δn_eff/δv), rad/s."""
+    Ts, g, dn2, k_w, inv_J, dv2_min, a_avg, leak = (
         coef[0], coef[1], coef[2], coef[3], coef[4], coef[5], coef[6], coef[7])
     v2 = 0.0
     for i in range(3):
-        turned[2, i] = leak * turned[2, i] + Ts * (acc[k, i] - turned[0, i])
+        turned[3, i] += (1.0 - leak) * (acc[k, i] - turned[3, i])
+        turned[2, i] = leak * turned[2, i] + Ts * (acc[k, i] - turned[3, i])
         v2 += turned[2, i] * turned[2, i]
     w2 = gyr[k, 0] * gyr[k, 0] + gyr[k, 1] * gyr[k, 1] + gyr[k, 2] * gyr[k, 2]
-    state[13] += a_avg * (w2 - state[13])
-    state[14] += a_avg * (v2 / 3.0 - state[14])
-    dv2 = max(k_v * state[14], dv2_min)
-    return math.sqrt(g * math.sqrt((dn2 + k_w * state[13]) / dv2))
+    state[W2] += a_avg * (w2 - state[W2])
+    state[V2] += a_avg * (v2 / 3.0 - state[V2])
+    dv2 = max(inv_J * state[V2], dv2_min)
+    return math.sqrt(g * math.sqrt((dn2 + k_w * state[W2]) / dv2))
 
 
 @kernel()
@@ -111,9 +133,9 @@ def run_schedule(state, coef, gyr, acc, gravity, quat, omega_in, omega_out):
     (omega_out, N, rad/s) per sample. omega_in (N, rad/s) imposes the break frequencies
     (the offline smoother's passes); empty, they come from the local densities."""
     Ts = coef[0]
-    rows = state[ROWS].reshape((3, 3))
+    rows = state[ROWS].reshape((4, 3))
     q = state[QUAT]
-    turned = np.empty((3, 3))
+    turned = np.empty((4, 3))
     Ad, Bd, C = np.empty((2, 2)), np.empty(2), np.array([1.0, 0.0])
     imposed = omega_in.shape[0] > 0
     for k in range(gyr.shape[0]):
@@ -121,15 +143,15 @@ def run_schedule(state, coef, gyr, acc, gravity, quat, omega_in, omega_out):
         omega = local_omega_g(state, coef, gyr, acc, k, turned)
         if imposed:
             omega = omega_in[k]
-        if state[15] > 0.0:  # keep e = u/ω_g continuous across a change of ω_g
+        if state[OMEGA] > 0.0:  # keep e = u/ω_g continuous across a change of ω_g
             for i in range(3):
-                turned[1, i] *= omega / state[15]
-        state[15] = omega
+                turned[1, i] *= omega / state[OMEGA]
+        state[OMEGA] = omega
         omega_out[k] = omega
         butterworth_zoh(omega * Ts, Ad, Bd)
         filter_rows(rows, turned, acc, k, Ad, Bd, C, 0.0, gravity)
         for i in range(3):
-            rows[2, i] = turned[2, i]
+            rows[2, i], rows[3, i] = turned[2, i], turned[3, i]
         level_onto_gravity(q, dq, gravity, k)
         quat[k, 0], quat[k, 1], quat[k, 2], quat[k, 3] = q[0], q[1], q[2], q[3]
 

@@ -2,8 +2,9 @@
 
 Bounds hold where the theory gives them, for Rizun's filters (`wiener`, and the
 first-order filter of §4.2): on `human` the RMS inclination error may exceed the
-analytic value of the method's filter (eq. 41 over the profile's spectrum; eq. 50 for
-`wiener`) by at most RMS_MARGIN; on `lever_arm` (Rizun §2.4), `incline` (§2.5),
+analytic value of the method's filter (eq. 41 over the profile's spectrum; for `wiener`
+eq. 34 at the break frequency its local densities settle on for the profile,
+blocks.wiener_local.settled_filter) by at most RMS_MARGIN; on `lever_arm` (Rizun §2.4), `incline` (§2.5),
 `offset_rotation` (Tseng 5) and `linear_motion` (Tseng 4) the mean error (tilt of the
 time-averaged estimate) stays below 0.05°; on the pure rotations `coning`, `sine_rotation`
 and `step_rotation` with ideal sensors the RMS error stays below EXACT_BOUND_DEG, since
@@ -55,9 +56,12 @@ class Scenario:
         if self.metric == "mean":
             return BIAS_BOUND_DEG
         motion = PROFILES[profile].motion()
-        params = get_method(method).resolve()
-        ms = accuracy.mean_square_error(get_method(method).filter(), params["delta_n"], motion.delta_v,
-                                        motion.omega_c, motion.g)
+        m = get_method(method)
+        params = m.resolve()
+        filt = m.filter()
+        if m.kernel is not None and m.uses_kernel(params):  # wiener's local densities: where they settle
+            filt = m.kernel.settled_filter(params, 3.0 * motion.rot_rms**2, motion.delta_v)
+        ms = accuracy.mean_square_error(filt, params["delta_n"], motion.delta_v, motion.omega_c, motion.g)
         return RMS_MARGIN * math.degrees(math.sqrt(2.0 * ms) / motion.g)
 
 

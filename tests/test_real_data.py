@@ -82,7 +82,10 @@ def test_gyro_offset_converges_and_attitude_stays_bounded_over_an_hour():
     # no drift: the last ten minutes are no worse than the first hour's quarter
     assert inclination[-60000:].max() < 2 * inclination[after_first_rest:int(900 * FS)].max() + 0.1
     # without the offset estimator the same recording is far off
-    assert np.degrees(inclination_error(estimate(gyr, acc, FS).gravity, motion.up)).max() > 5.0
+    without = np.degrees(inclination_error(estimate(gyr, acc, FS).gravity, motion.up))
+    print(f"max inclination error with the offset estimator {inclination[after_first_rest:].max():.2f}°, "
+          f"without {without[after_first_rest:].max():.2f}°")
+    assert without[after_first_rest:].max() > 4 * inclination[after_first_rest:].max()
 
 
 def _broad_like(path, motion, quat_ref=True, movement=True):
