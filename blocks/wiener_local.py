@@ -90,7 +90,7 @@ def butterworth_zoh(wt, Ad, Bd):
     (−1 ± i)/√2, so exp(M·t) = e^(−t/√2)·(cos(t/√2)·I + √2·sin(t/√2)·(M + I/√2)); for
     small wt its Taylor series (Horner form, no transcendental calls) is used instead."""
     if wt < SERIES_WT:
-        # columns of I + M·wt·(I + M·wt/2·(I + … (I + M·wt/8))), kept as [[p, q], [r, s]]
+        # I + M·wt·(I + M·wt/2·(I + … (I + M·wt/8))), kept as [[p, q], [r, t]]
         p, q, r, t = 1.0, 0.0, 0.0, 1.0
         for j in range(8, 0, -1):
             c = wt / j
