@@ -92,7 +92,8 @@ LOCAL_NOISE_PARAMS = (
           "error (datasheet)", True),
     Param("omega_m", 10.0, "rad/s", "band limit of the motion (velocity and rate) in the local densities"),
     Param("tau_noise", 1.0, "s", "averaging time of the local densities"),
-    Param("tau_v", 1.0, "s", "time constant of the high-pass on the velocity residual"),
+    Param("tau_v", 1.0, "s", "time constant of the band-pass that turns the accelerometer into the "
+          "slosh velocity"),
     Param("delta_v_min", 0.01, "m/s/√Hz", "floor of the local slosh density (rest)"),
 )
 
