@@ -98,10 +98,13 @@ LOCAL_NOISE_PARAMS = (
 )
 
 
+def design_delta_v(p: Mapping[str, float | None]) -> float:
+    """The slosh density (m/s/√Hz) the stationary filter is designed for."""
+    return p["delta_v"] if p["delta_v"] is not None else NOMINAL_DELTA_V
+
+
 def _omega_g(p: Mapping[str, float | None]) -> float:
-    if p["omega_g"] is not None:
-        return p["omega_g"]
-    return ef.omega_g(p["delta_n"], p["delta_v"] if p["delta_v"] is not None else NOMINAL_DELTA_V, p["g"])
+    return p["omega_g"] if p["omega_g"] is not None else ef.omega_g(p["delta_n"], design_delta_v(p), p["g"])
 
 
 def _wiener_is_local(p: Mapping[str, float | None]) -> bool:

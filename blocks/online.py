@@ -12,7 +12,7 @@ from .heading import heading_step
 from .heading import initial_state as heading_initial_state
 from .heading import resolve as heading_resolve
 from .jit import kernel
-from .methods import stepper
+from .methods import method as get_method, stepper
 from .quaternion import quat_euler_zyx
 from .sensor_frame import SensorFrameStepper, sensor_frame_step, start_gravity
 
@@ -74,7 +74,8 @@ class OnlineEstimator:
     """
 
     def __init__(self, method: str = "wiener", params: Mapping[str, float] | None = None, heading: bool = False):
-        stepper(method, tuple(sorted((params or {}).items())), 1.0)  # refuse bad methods and parameters now
+        m = get_method(method)
+        m.uses_kernel(m.resolve(params))  # refuse unknown methods and bad parameters now
         self.method = method
         self.params = tuple(sorted((params or {}).items()))
         self.heading = heading

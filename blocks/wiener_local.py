@@ -30,7 +30,7 @@ import numpy as np
 
 from scipy.integrate import quad
 
-from .earth_filters import butterworth
+from .earth_filters import butterworth, omega_g
 from .jit import kernel
 from .sensor_frame import filter_rows, level_onto_gravity, turn_rows
 
@@ -65,9 +65,8 @@ def settled_filter(params, rate_ms: float, delta_v: float):
     of mean-square angular rate rate_ms (rad²/s², all axes together) and slosh delta_v
     (m/s/√Hz, eq. 14 band-limited at omega_m): the filter whose eq. 41 error the local
     filter has on such motion (tests/test_wiener_local.py)."""
-    dn2 = params["delta_n"] ** 2 + 4.0 * params["scale_error"] ** 2 / params["omega_m"] * rate_ms
-    dv2 = max(delta_v**2, params["delta_v_min"] ** 2)
-    return butterworth(math.sqrt(params["g"] * math.sqrt(dn2 / dv2)))
+    _, g, dn2, k_w, _, dv2_min, _, _ = coefficients(params, 1.0)
+    return butterworth(omega_g(math.sqrt(dn2 + k_w * rate_ms), math.sqrt(max(delta_v**2, dv2_min)), g))
 
 
 def initial_state(coef, acc0) -> np.ndarray:
@@ -81,28 +80,15 @@ def initial_state(coef, acc0) -> np.ndarray:
     return state
 
 
-SERIES_WT = 0.02  # below it the Taylor series of exp(M·wt) to wt⁸ is exact to double precision
-
-
 @kernel(inline=True)
 def butterworth_zoh(wt, Ad, Bd):
     """Ad = exp(M·wt), Bd = M⁻¹·(Ad − I)·[0, 1] for wt = ω_g·Ts (rad). M has eigenvalues
-    (−1 ± i)/√2, so exp(M·t) = e^(−t/√2)·(cos(t/√2)·I + √2·sin(t/√2)·(M + I/√2)); for
-    small wt its Taylor series (Horner form, no transcendental calls) is used instead."""
-    if wt < SERIES_WT:
-        # I + M·wt·(I + M·wt/2·(I + … (I + M·wt/8))), kept as [[p, q], [r, t]]
-        p, q, r, t = 1.0, 0.0, 0.0, 1.0
-        for j in range(8, 0, -1):
-            c = wt / j
-            # I + c·M·X with M·X = [[r, t], [−p − √2·r, −q − √2·t]]
-            p, q, r, t = 1.0 + c * r, c * t, -c * (p + SQRT2 * r), 1.0 - c * (q + SQRT2 * t)
-        Ad[0, 0], Ad[0, 1], Ad[1, 0], Ad[1, 1] = p, q, r, t
-    else:
-        a = wt / SQRT2
-        e = math.exp(-a)
-        c, s = e * math.cos(a), e * math.sin(a) * SQRT2
-        Ad[0, 0], Ad[0, 1] = c + s / SQRT2, s
-        Ad[1, 0], Ad[1, 1] = -s, c - s / SQRT2
+    (−1 ± i)/√2, so exp(M·t) = e^(−t/√2)·(cos(t/√2)·I + √2·sin(t/√2)·(M + I/√2))."""
+    a = wt / SQRT2
+    e = math.exp(-a)
+    c, s = e * math.cos(a), e * math.sin(a) * SQRT2
+    Ad[0, 0], Ad[0, 1] = c + s / SQRT2, s
+    Ad[1, 0], Ad[1, 1] = -s, c - s / SQRT2
     # M⁻¹ = [[−√2, −1], [1, 0]] applied to (Ad − I)[:, 1]
     Bd[0] = -SQRT2 * Ad[0, 1] - (Ad[1, 1] - 1.0)
     Bd[1] = Ad[0, 1]
@@ -123,8 +109,7 @@ def local_omega_g(state, coef, gyr, acc, k, turned):
     w2 = gyr[k, 0] * gyr[k, 0] + gyr[k, 1] * gyr[k, 1] + gyr[k, 2] * gyr[k, 2]
     state[W2] += a_avg * (w2 - state[W2])
     state[V2] += a_avg * (v2 / 3.0 - state[V2])
-    dv2 = max(inv_J * state[V2], dv2_min)
-    return math.sqrt(g * math.sqrt((dn2 + k_w * state[W2]) / dv2))
+    return math.sqrt(g * math.sqrt((dn2 + k_w * state[W2]) / max(inv_J * state[V2], dv2_min)))  # eq. 25
 
 
 @kernel()

@@ -76,22 +76,23 @@ def estimate(
     step = stepper(method, tuple(sorted((params or {}).items())), 1.0 / fs)
     if initial_gravity is None:
         initial_gravity = start_gravity(gyr[0], acc[0], 1.0 / fs)
-    forward = _run(step, gyr, acc, initial_gravity)
-    forward.offset = offset
     if not offline:
+        forward = _run(step, gyr, acc, initial_gravity)
+        forward.offset = offset
         return _with_heading(forward, mag, fs)
     if not get_method(method).is_sensor_frame:
         raise ValueError(f"offline smoothing needs an earth-frame filter method "
                          f"({', '.join(n for n, m in METHODS.items() if m.is_sensor_frame)}), not {method!r}")
     gyr_back = _backward(gyr)
     if isinstance(step, KernelStepper):
-        # wiener with local densities: the break frequency of both passes is the lower of the
-        # causal estimates running forward and backward in time
+        # wiener's local densities: both passes run at the lower of the break frequencies
+        # estimated causally forward and backward in time
         omega = np.minimum(_run_local(step, gyr, acc, initial_gravity)[1],
                            _run_local(step, gyr_back, acc[::-1], acc[-1])[1][::-1])
-        forward = AttitudeEstimate(*_run_local(step, gyr, acc, initial_gravity, omega)[0], offset)
+        forward = AttitudeEstimate(*_run_local(step, gyr, acc, initial_gravity, omega)[0])
         backward = _run_local(step, gyr_back, forward.gravity[::-1], forward.gravity[-1], omega[::-1])[0][0]
     else:
+        forward = _run(step, gyr, acc, initial_gravity)
         backward = _run(step, gyr_back, np.ascontiguousarray(forward.gravity[::-1]), forward.gravity[-1]).gravity
     gravity = backward[::-1].copy()
     return _with_heading(AttitudeEstimate(gravity, level_onto(forward.quat, gravity), offset), mag, fs)

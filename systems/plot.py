@@ -8,7 +8,7 @@ from scipy import signal
 from scipy.spatial.transform import Rotation
 
 from blocks import accuracy
-from blocks.methods import NOMINAL_DELTA_V, method as get_method
+from blocks.methods import design_delta_v, method as get_method
 
 from .batch import estimate
 from .errors import quaternion_errors
@@ -51,7 +51,7 @@ def plot_recording(path, out, method: str = "wiener", params=None, offline: bool
         p = m.resolve(params)
         g = p["g"]
         # one-sided per Hz: 2·S(2πf); divided by g² for a tilt in rad
-        delta_v = p["delta_v"] if p["delta_v"] is not None else NOMINAL_DELTA_V
+        delta_v = design_delta_v(p)
         model = 2 * accuracy.butterworth_error_spectrum(2 * np.pi * f[1:], p["delta_n"], delta_v, g) / g**2
         bottom.loglog(f[1:], model, "--", label=f"eq. 42, stationary noise model (δv = {delta_v:g} m/s/√Hz)")
     bottom.set_xlabel("frequency, Hz")
