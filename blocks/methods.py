@@ -53,19 +53,23 @@ def resolve_params(params: tuple[Param, ...], overrides: Mapping[str, float] | N
 @dataclass(frozen=True)
 class Method:
     """design gives the earth-frame filter of a sensor-frame method; kernel is the module
-    of a method with a step of its own. A method with both steps with its kernel when
-    uses_kernel(resolved params) is true, with its earth-frame filter otherwise."""
+    of a method with a step of its own. A method with both runs its kernel where
+    kernel_when(resolved params) is true (runs_kernel), its earth-frame filter otherwise."""
 
     name: str
     summary: str
     params: tuple[Param, ...]
     design: Callable[[Mapping[str, float | None]], control.TransferFunction] | None = None
     kernel: object = None
-    uses_kernel: Callable[[Mapping[str, float | None]], bool] = lambda p: True
+    kernel_when: Callable[[Mapping[str, float | None]], bool] = lambda p: True
 
     def resolve(self, overrides: Mapping[str, float] | None = None) -> dict[str, float | None]:
         """Defaults updated by overrides; unknown names and non-positive values are refused."""
         return resolve_params(self.params, overrides, f"method {self.name!r}")
+
+    def runs_kernel(self, p: Mapping[str, float | None]) -> bool:
+        """Whether resolved parameters p select the method's own step over its filter."""
+        return self.kernel is not None and self.kernel_when(p)
 
     @property
     def is_sensor_frame(self) -> bool:
@@ -135,7 +139,7 @@ METHODS: dict[str, Method] = {
         ) + LOCAL_NOISE_PARAMS,
         _design_wiener,
         kernel=wiener_local,
-        uses_kernel=_wiener_is_local,
+        kernel_when=_wiener_is_local,
     ),
     "tseng": Method(
         "tseng",
@@ -219,7 +223,7 @@ def stepper(name: str, params: tuple, Ts: float):
     """The stepper of method name for params ((name, value) pairs) at sample time Ts (s)."""
     m = method(name)
     resolved = m.resolve(dict(params))
-    if m.kernel is None or not m.uses_kernel(resolved):
+    if not m.runs_kernel(resolved):
         return SensorFrameStepper(discrete_filter(name, params, Ts))
     if not (math.isfinite(Ts) and Ts > 0):
         raise ValueError(f"sample time Ts must be a finite positive number of seconds, got {Ts!r}")

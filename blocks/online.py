@@ -75,7 +75,7 @@ class OnlineEstimator:
 
     def __init__(self, method: str = "wiener", params: Mapping[str, float] | None = None, heading: bool = False):
         m = get_method(method)
-        m.uses_kernel(m.resolve(params))  # refuse unknown methods and bad parameters now
+        m.runs_kernel(m.resolve(params))  # refuse unknown methods and bad parameters now
         self.method = method
         self.params = tuple(sorted((params or {}).items()))
         self.heading = heading

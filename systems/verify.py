@@ -58,9 +58,10 @@ class Scenario:
         motion = PROFILES[profile].motion()
         m = get_method(method)
         params = m.resolve()
-        filt = m.filter()
-        if m.kernel is not None and m.uses_kernel(params):  # wiener's local densities: where they settle
+        if m.runs_kernel(params):  # wiener's local densities: eq. 34 where they settle
             filt = m.kernel.settled_filter(params, 3.0 * motion.rot_rms**2, motion.delta_v)
+        else:
+            filt = m.design(params)
         ms = accuracy.mean_square_error(filt, params["delta_n"], motion.delta_v, motion.omega_c, motion.g)
         return RMS_MARGIN * math.degrees(math.sqrt(2.0 * ms) / motion.g)
 
