@@ -1,10 +1,27 @@
 """Gyroscope-offset estimator (the "gyro offset estimator" box of Rizun's Fig. 1).
 
-Rest detection: the gyro and the accelerometer, each low-passed (time constant tau_lp),
-must stay close to their low-passed values (rest_gyr, rest_acc) and the low-passed gyro
-must stay small (rest_gyr_abs) for rest_time seconds; while at rest the offset estimate
-follows the low-passed gyro with time constant tau_bias. The corrected gyro is the
-measured one minus the current estimate. Causal, one compiled step per sample.
+At rest: the gyro and the accelerometer, each low-passed (time constant tau_lp), must stay
+close to their low-passed values (rest_gyr, rest_acc) and the low-passed gyro must stay
+small (rest_gyr_abs) for rest_time seconds; then the offset estimate follows the
+low-passed gyro with time constant tau_bias.
+
+While moving, the offset's effect on the accelerometer is tracked in the gyro frame (the
+frame integrated from the corrected gyro; R its sensor → gyro-frame rotation), the way
+vqf (Laidig & Seel 2023) does. There the accelerometer is low-passed by eq. 34's
+Butterworth at √2/tau_acc, which averages the motion's acceleration out as in Rizun's
+filter, and an offset error Δb turns gravity at the rate R·Δb, so the low-passed
+direction turns at c = H·Δb with H = Π·LP(R) (Π: the projection across gravity; LP the
+same low-pass). A Kalman filter (variance from sigma_init, process noise such that the
+variance settles on sigma_motion² and forgets in tau_motion) updates the estimate from
+c. Guards, all from the same model:
+- while the sensor turns quickly about an axis, LP(R) averages out the offset's
+  components across it; directions in which H keeps less than half of them are left
+  alone, since a sensor-fixed (e.g. centripetal) acceleration looks the same there;
+- innovations are clipped at 4·sigma_init, the fastest turn a plausible offset makes;
+- no update in the first 3·tau_acc, while the low-pass forgets its first sample.
+A rest phase replaces the estimate by the rest average and its variance shrinks with
+the old estimate's weight. The corrected gyro is the measured one minus the current
+estimate. Causal, one compiled step per sample.
 """
 from __future__ import annotations
 
@@ -14,6 +31,8 @@ import numpy as np
 
 from .jit import kernel
 from .methods import Param, resolve_params
+from .quaternion import quat_multiply, quat_normalized, quat_rotate, rotvec_quat
+from .wiener_local import butterworth_zoh
 
 PARAMS = (
     Param("rest_gyr", math.radians(2.0), "rad/s", "largest deviation of the gyro from its low-pass at rest"),
@@ -22,8 +41,23 @@ PARAMS = (
     Param("rest_time", 1.5, "s", "time the rest conditions must hold"),
     Param("tau_lp", 0.5, "s", "time constant of the low-passes of the rest detection"),
     Param("tau_bias", 10.0, "s", "time constant of the offset estimate's averaging at rest"),
+    Param("tau_acc", 3.0, "s", "time constant of the accelerometer low-pass in the gyro frame (motion tracking)"),
+    Param("sigma_init", math.radians(0.5), "rad/s", "uncertainty of the offset before any rest (per axis)"),
+    Param("sigma_motion", math.radians(0.1), "rad/s", "uncertainty the tracking while moving settles on (per axis)"),
+    Param("tau_motion", 100.0, "s", "time in which the offset may drift by sigma_motion; 0: no tracking while moving",
+          allow_zero=True),
 )
-STATE_NAMES = ("glp_x", "glp_y", "glp_z", "alp_x", "alp_y", "alp_z", "rest_s", "b_x", "b_y", "b_z")
+STATE_NAMES = (
+    "glp_x", "glp_y", "glp_z", "alp_x", "alp_y", "alp_z",  # low-passed gyro (rad/s) and accelerometer (m/s²)
+    "rest_s", "b_x", "b_y", "b_z",  # time at rest (s), offset estimate (rad/s)
+    "t",  # time since the start (s)
+    "q_w", "q_x", "q_y", "q_z",  # sensor → gyro frame
+    *(f"a{r}_{i}" for r in "xu" for i in "xyz"),  # Butterworth rows of the accelerometer in the gyro frame
+    *(f"R{r}_{i}{j}" for r in "xu" for i in "123" for j in "123"),  # Butterworth rows of R
+    *(f"Rb{r}_{i}" for r in "xu" for i in "xyz"),  # Butterworth rows of R·b (rad/s)
+    *(f"P_{i}{j}" for i in "xyz" for j in "xyz"),  # covariance of the offset estimate, (rad/s)²
+)
+T, QUAT, ACC_LP, R_LP, RB_LP, COV = 10, slice(11, 15), slice(15, 21), slice(21, 39), slice(39, 45), slice(45, 54)
 
 
 def resolve(overrides=None) -> dict:
@@ -31,21 +65,87 @@ def resolve(overrides=None) -> dict:
 
 
 def coefficients(params, Ts: float) -> np.ndarray:
-    """[Ts, a_lp, a_bias, rest_gyr, rest_gyr_abs, rest_acc, rest_time]; a_* = 1 − exp(−Ts/τ)."""
+    """[Ts, a_lp, a_bias, rest_gyr, rest_gyr_abs, rest_acc, rest_time, ω_acc·Ts, P0, V, W]:
+    a_* = 1 − exp(−Ts/τ), ω_acc = √2/τ_acc (rad/s); the Kalman update while moving has the
+    initial variance P0 = σ_init², the process noise V = σ_motion²·Ts/τ_motion per sample
+    and the measurement noise W = σ_motion⁴/V + σ_motion², with which its variance settles
+    on σ_motion² (V = 0: no tracking while moving)."""
+    tau_motion, s2 = params["tau_motion"], params["sigma_motion"] ** 2
+    V = s2 * Ts / tau_motion if tau_motion > 0 else 0.0
     return np.array([Ts, 1.0 - math.exp(-Ts / params["tau_lp"]), 1.0 - math.exp(-Ts / params["tau_bias"]),
-                     params["rest_gyr"], params["rest_gyr_abs"], params["rest_acc"], params["rest_time"]])
+                     params["rest_gyr"], params["rest_gyr_abs"], params["rest_acc"], params["rest_time"],
+                     math.sqrt(2.0) / params["tau_acc"] * Ts, params["sigma_init"] ** 2, V,
+                     s2 * s2 / V + s2 if V > 0 else 0.0])
 
 
-def initial_state(gyr0, acc0) -> np.ndarray:
-    """Low-passes on the first samples, not at rest, no offset."""
-    return np.concatenate([gyr0, acc0, [0.0], [0.0, 0.0, 0.0]])
+def initial_state(coef, gyr0, acc0) -> np.ndarray:
+    """Low-passes on the first samples, not at rest, no offset (variance P0), the gyro
+    frame on the sensor, its low-passes settled on acc0 and R = I."""
+    state = np.zeros(len(STATE_NAMES))
+    state[0:3], state[3:6] = gyr0, acc0
+    state[QUAT] = (1.0, 0.0, 0.0, 0.0)
+    state[ACC_LP][0:3] = acc0
+    state[R_LP][0:9] = np.eye(3).ravel()
+    state[COV] = coef[8] * np.eye(3).ravel()
+    return state
+
+
+@kernel(inline=True)
+def lowpass_step(rows, j, x, Ad, Bd):
+    """Column j of the Butterworth's two state rows after the input x."""
+    x0, x1 = rows[0, j], rows[1, j]
+    rows[0, j] = Ad[0, 0] * x0 + Ad[0, 1] * x1 + Bd[0] * x
+    rows[1, j] = Ad[1, 0] * x0 + Ad[1, 1] * x1 + Bd[1] * x
+
+
+@kernel(inline=True)
+def across(v, u, n2):
+    """v minus its component along u (|u|² = n2)."""
+    dot = (v[0] * u[0] + v[1] * u[1] + v[2] * u[2]) / n2
+    return np.array([v[0] - dot * u[0], v[1] - dot * u[1], v[2] - dot * u[2]])
+
+
+@kernel(inline=True)
+def motion_update(b, P, old, new, r_lp, rb_lp, Ts, W, clip):
+    """Kalman update of the offset b (P its covariance) from the turn of the low-passed
+    accelerometer from old to new (gyro frame); r_lp, rb_lp: LP(R) (row-major) and LP(R·b)."""
+    n2 = new[0] * new[0] + new[1] * new[1] + new[2] * new[2]
+    if n2 == 0.0:
+        return
+    H = np.empty((3, 3))
+    for j in range(3):
+        H[:, j] = across((r_lp[j], r_lp[3 + j], r_lp[6 + j]), new, n2)
+    # the turn rate plus Π·LP(R·b̂) measures H·b (the low-pass delays the turn after a
+    # change of b̂); clipped innovation
+    s = 1.0 / (n2 * Ts)
+    turn = np.array([old[1] * new[2] - old[2] * new[1], old[2] * new[0] - old[0] * new[2],
+                     old[0] * new[1] - old[1] * new[0]]) * s
+    e = np.minimum(np.maximum(turn + across(rb_lp, new, n2) - H @ b, -clip), clip)
+    # only the directions H keeps at least half of
+    U, sv, Vt = np.linalg.svd(H)
+    kept = (sv >= 0.5).astype(np.float64)
+    Uk = U * kept
+    Hk = (Uk * sv) @ Vt
+    PHt = P @ Hk.T
+    K = PHt @ np.linalg.inv(Hk @ PHt + W * np.eye(3))
+    b += K @ (Uk @ (Uk.T @ e))
+    P -= K @ Hk @ P
 
 
 @kernel()
 def run(state, coef, gyr, acc, corrected, offset):
     """Over N samples: corrected gyro (N×3, rad/s) and offset estimate (N×3) per sample."""
-    Ts, a_lp, a_bias, rest_gyr, rest_gyr_abs, rest_acc, rest_time = (
-        coef[0], coef[1], coef[2], coef[3], coef[4], coef[5], coef[6])
+    Ts, a_lp, a_bias, rest_gyr, rest_gyr_abs, rest_acc, rest_time, wt, P0, V, W = (
+        coef[0], coef[1], coef[2], coef[3], coef[4], coef[5], coef[6], coef[7], coef[8], coef[9], coef[10])
+    settle = 3.0 * math.sqrt(2.0) * Ts / wt  # 3·τ_acc
+    clip = 4.0 * math.sqrt(P0)
+    Ad, Bd = np.empty((2, 2)), np.empty(2)
+    butterworth_zoh(wt, Ad, Bd)
+    b = state[7:10]
+    acc_lp = state[ACC_LP].reshape((2, 3))
+    r_lp = state[R_LP].reshape((2, 9))
+    rb_lp = state[RB_LP].reshape((2, 3))
+    P = state[COV].reshape((3, 3))
     for k in range(gyr.shape[0]):
         dg2 = 0.0
         da2 = 0.0
@@ -59,17 +159,41 @@ def run(state, coef, gyr, acc, corrected, offset):
         still = dg2 < rest_gyr * rest_gyr and da2 < rest_acc * rest_acc and g2 < rest_gyr_abs * rest_gyr_abs
         state[6] = state[6] + Ts if still else 0.0
         for i in range(3):
-            if state[6] >= rest_time:
-                state[7 + i] += a_bias * (state[i] - state[7 + i])
-            offset[k, i] = state[7 + i]
-            corrected[k, i] = gyr[k, i] - state[7 + i]
+            corrected[k, i] = gyr[k, i] - b[i]
+        q = quat_normalized(quat_multiply(
+            (state[11], state[12], state[13], state[14]),
+            rotvec_quat(corrected[k, 0] * Ts, corrected[k, 1] * Ts, corrected[k, 2] * Ts)))
+        state[11], state[12], state[13], state[14] = q
+        state[T] += Ts
+        # the accelerometer, R·b and R (column j: the sensor's axis j) low-passed in the gyro frame
+        old = acc_lp[0].copy()
+        a = quat_rotate(q, (acc[k, 0], acc[k, 1], acc[k, 2]))
+        rb = quat_rotate(q, (b[0], b[1], b[2]))
+        for i in range(3):
+            lowpass_step(acc_lp, i, a[i], Ad, Bd)
+            lowpass_step(rb_lp, i, rb[i], Ad, Bd)
+        for j in range(3):
+            col = quat_rotate(q, (1.0 if j == 0 else 0.0, 1.0 if j == 1 else 0.0, 1.0 if j == 2 else 0.0))
+            for i in range(3):
+                lowpass_step(r_lp, 3 * i + j, col[i], Ad, Bd)
+        for i in range(3):
+            P[i, i] = min(P[i, i] + V, P0)
+        if state[6] >= rest_time:
+            for i in range(3):
+                b[i] += a_bias * (state[i] - b[i])
+            P *= (1.0 - a_bias) ** 2
+        elif V > 0.0 and state[T] > settle:
+            motion_update(b, P, old, acc_lp[0], r_lp[0], rb_lp[0], Ts, W, clip)
+        for i in range(3):
+            offset[k, i] = b[i]
 
 
 def correct(gyr, acc, fs: float, params=None):
     """(corrected gyro, offset estimate), both N×3 rad/s, over a whole recording."""
     gyr = np.ascontiguousarray(gyr, dtype=float)
     acc = np.ascontiguousarray(acc, dtype=float)
-    state = initial_state(gyr[0], acc[0])
+    coef = coefficients(resolve(params), 1.0 / fs)
+    state = initial_state(coef, gyr[0], acc[0])
     corrected, offset = np.empty_like(gyr), np.empty_like(gyr)
-    run(state, coefficients(resolve(params), 1.0 / fs), gyr, acc, corrected, offset)
+    run(state, coef, gyr, acc, corrected, offset)
     return corrected, offset

@@ -50,7 +50,7 @@ def test_magnetometer_heading_stays_bounded_in_the_disturbance_trials(table):
 
 def test_vqf_figures_are_the_wiener_filter_at_its_break_frequency(table):
     """vqf's default is Rizun's filter at omega_g = √2/tau_acc (tests/test_estimators.py):
-    with the gyro offset estimated at rest, our figures at that omega_g match vqf's per file."""
+    with the gyro offset estimated, our figures at that omega_g match vqf's per file."""
     for path in FILES:
         rec = read_recording(path)
         est = estimate(rec.gyr, rec.acc, rec.fs, "wiener", {"omega_g": math.sqrt(2) / VQF_TAU_ACC}, gyro_offset=True)

@@ -1,10 +1,6 @@
 """The sensor-frame estimator blocks: linearisation, exactness, and one step behind
 the continuous block, the discrete block, the batch path and the plain-Python source."""
-import json
 import math
-import os
-import subprocess
-import sys
 
 import control
 import numpy as np
@@ -17,6 +13,7 @@ from blocks.sensor_frame import initial_state, sensor_frame_system, start_gravit
 from systems.batch import estimate
 from systems.errors import inclination_error
 from systems.motion import HumanMotion
+from tests.interpreted import interpreted_json
 
 FILTERS = {
     "eq34": ef.butterworth(0.13),
@@ -69,10 +66,7 @@ def test_compiled_kernel_equals_its_plain_python_source():
         "g, a = _random_imu(); e = estimate(g, a, 100.0);"
         "print(json.dumps([e.gravity.tolist(), e.quat.tolist()]))"
     )
-    env = dict(os.environ, NUMBA_DISABLE_JIT="1")
-    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    out = subprocess.run([sys.executable, "-c", code], env=env, cwd=root, capture_output=True, text=True, check=True)
-    gravity, quat = (np.array(x) for x in json.loads(out.stdout))
+    gravity, quat = (np.array(x) for x in interpreted_json(code))
     compiled = estimate(*_random_imu(), 100.0)
     assert np.abs(gravity - compiled.gravity).max() <= 1e-12
     assert np.abs(quat - compiled.quat).max() <= 1e-12
