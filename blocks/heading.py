@@ -6,10 +6,12 @@ about earth up by ψ_c, which follows the heading of the tilt-compensated field:
 plane, so δψ = atan2(m_e,x, m_e,y) is the heading error's negative and ψ_c += a·clip(δψ) with
 a = 1 − exp(−Ts/tau) and the innovation clipped to ±heading_clip (a robust update: a
 disturbance that slips through the guard pulls by at most heading_clip/tau_heading per
-second). The first accepted sample sets the heading at once. Guard against magnetic
-disturbances: a sample is used only while the field's norm and dip stay within tolerance
-of a reference, learned from the first sample and tracked slowly (tau_reference) over
-accepted samples; otherwise the heading is the gyro's.
+second). Start-up: over the first tau_heading seconds every sample is used, unclipped,
+with the weight 1/n of a running mean, and the reference norm and dip are their running
+means (the first samples may come in motion, while the tilt is still settling). Then
+the guard against magnetic disturbances: a sample is used only while the field's norm
+and dip stay within tolerance of the reference, which is tracked slowly (tau_reference)
+over accepted samples; otherwise the heading is the gyro's.
 Inclination is untouched: the correction turns about the vertical only.
 """
 from __future__ import annotations
@@ -42,8 +44,8 @@ def coefficients(params, Ts: float) -> np.ndarray:
 
 
 def initial_state() -> np.ndarray:
-    """[ψ_c (rad), reference norm (negative: not learned yet), reference dip (rad)]."""
-    return np.array([0.0, -1.0, 0.0])
+    """[ψ_c (rad), reference norm, reference dip (rad), samples seen with a field]."""
+    return np.array([0.0, 0.0, 0.0, 0.0])
 
 
 @kernel(inline=True)
@@ -58,9 +60,12 @@ def heading_step(state, coef, q, m_sensor):
     ok = False
     if norm > 0.0 and horizontal > 0.0:
         dip = math.atan2(-m[2], horizontal)
-        if state[1] < 0.0:
-            state[1], state[2], ok = norm, dip, True
-            state[0] = math.atan2(m[0], m[1])
+        state[3] += 1.0
+        if 1.0 / state[3] > a_heading:  # start-up: running means, every sample
+            ok = True
+            state[0] += math.atan2(m[0], m[1]) / state[3]
+            state[1] += (norm - state[1]) / state[3]
+            state[2] += (dip - state[2]) / state[3]
         elif abs(norm - state[1]) <= norm_tol * state[1] and abs(dip - state[2]) <= dip_tol:
             ok = True
             state[0] += a_heading * min(clip, max(-clip, math.atan2(m[0], m[1])))

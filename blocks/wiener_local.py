@@ -20,7 +20,10 @@ With σ_s = 0 and a steady motion the estimates settle on the stationary densiti
 filter on eq. 34. The Butterworth runs in the realisation d/dt[ĝ, u] = ω_g·M·[ĝ, u] +
 ω_g·[0, 1]·y_a with M = [[0, 1], [−1, −√2]] (u = ω_g·e, e the velocity residual of the
 filter), whose zero-order hold has a closed form for every ω_g; e is kept continuous when
-ω_g changes. One compiled step serves the python-control block, the batch path and the FMU.
+ω_g changes. Start-up: while the time since the start is below the time constant √2/ω_g,
+ĝ is the mean of the accelerometer so far in the gyro frame (u = 0); a first sample in
+motion is not trusted alone. One compiled step serves the python-control block, the
+batch path and the FMU.
 """
 from __future__ import annotations
 
@@ -41,10 +44,11 @@ STATE_NAMES = (
     "f_x", "f_y", "f_z",  # low-passed accelerometer, m/s² (all four rows turn with the gyro)
     "q_w", "q_x", "q_y", "q_z",  # orientation, sensor → earth
     "w2", "v2", "omega_g",  # ⟨|ω|²⟩ (rad²/s²), ⟨|v|²⟩/3 (m²/s²), last break frequency (rad/s)
+    "t",  # time since the start (s)
 )
 ROWS = slice(0, 12)
 QUAT = slice(12, 16)
-W2, V2, OMEGA = 16, 17, 18
+W2, V2, OMEGA, T = 16, 17, 18, 19
 SQRT2 = math.sqrt(2.0)
 
 
@@ -70,8 +74,8 @@ def settled_filter(params, rate_ms: float, delta_v: float):
 
 
 def initial_state(coef, acc0) -> np.ndarray:
-    """At rest on acc0 (m/s²): ĝ along acc0 with the magnitude g (coef[1]), no residuals,
-    q = identity, no motion seen yet."""
+    """At rest on acc0 (m/s²): ĝ along acc0 with the magnitude g (coef[1]; the start-up's
+    mean then begins with the first sample), no residuals, q = identity, no motion seen."""
     state = np.zeros(len(STATE_NAMES))
     norm = float(np.linalg.norm(acc0))
     state[0:3] = acc0 * (coef[1] / norm) if norm > 0.0 else (0.0, 0.0, coef[1])
@@ -133,8 +137,18 @@ def run_schedule(state, coef, gyr, acc, gravity, quat, omega_in, omega_out):
                 turned[1, i] *= omega / state[OMEGA]
         state[OMEGA] = omega
         omega_out[k] = omega
-        butterworth_zoh(omega * Ts, Ad, Bd)
-        filter_rows(rows, turned, acc, k, Ad, Bd, C, 0.0, gravity)
+        state[T] += Ts
+        if state[T] * omega < SQRT2:
+            # start-up, within the filter's time constant √2/ω_g: the mean of the
+            # accelerometer so far in the gyro frame (no state velocity)
+            n = state[T] / Ts
+            for i in range(3):
+                rows[0, i] = turned[0, i] + (acc[k, i] - turned[0, i]) / n
+                rows[1, i] = 0.0
+                gravity[k, i] = rows[0, i]
+        else:
+            butterworth_zoh(omega * Ts, Ad, Bd)
+            filter_rows(rows, turned, acc, k, Ad, Bd, C, 0.0, gravity)
         for i in range(3):
             rows[2, i], rows[3, i] = turned[2, i], turned[3, i]
         level_onto_gravity(q, dq, gravity, k)

@@ -39,7 +39,7 @@ def _add_real_data_flags(parser) -> None:
     parser.add_argument("--offline", action="store_true",
                         help="forward-backward smoothing of the earth-frame filter (wiener: the Wiener smoother)")
     parser.add_argument("--gyro-offset", default="on", choices=["on", "off"],
-                        help="estimate and remove the gyro offset at rest (default on)")
+                        help="estimate and remove the gyro offset, at rest and while moving (default on)")
     parser.add_argument("--heading", default="mag", choices=["mag", "gyro"],
                         help="heading from the magnetometer when the input has one (default), or the gyro's (6D)")
 
@@ -69,6 +69,9 @@ def build_parser() -> argparse.ArgumentParser:
     ev.add_argument("--method", default="wiener", choices=sorted(METHODS))
     ev.add_argument("--param", type=_param, action="append", default=[], metavar="NAME=VALUE")
     ev.add_argument("--json", action="store_true")
+    ev.add_argument("--start-in-movement", type=float, metavar="S",
+                    help="begin each recording S seconds into its movement phase: no rest before, "
+                         "a first sample in motion (a test of start-up and offset tracking)")
     _add_real_data_flags(ev)
 
     pl = sub.add_parser("plot", help="a recording's error over time and its spectrum against eq. 42 (PNG)")
@@ -131,7 +134,7 @@ def cmd_evaluate(args) -> int:
         raise RuntimeError(f"attitude evaluate compares with vqf and ahrs ({exc}); "
                            "install them with: pip install 'attitude-fmu[peers]'") from None
     result = evaluate(args.files, args.method, dict(args.param), args.offline, args.gyro_offset == "on",
-                      args.heading == "mag")
+                      args.heading == "mag", start_in_movement=args.start_in_movement)
     if args.json:
         print(json.dumps(result, indent=2))
         return 0

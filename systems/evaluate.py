@@ -51,8 +51,9 @@ def evaluate_recording(rec: Recording, method: str = "wiener", params=None, offl
 
 
 def evaluate(paths, method: str = "wiener", params=None, offline: bool = False, gyro_offset: bool = True,
-             use_mag: bool = True, progress: bool = True) -> dict:
-    """{"recordings": {name: {label: metrics}}, "mean": {label: metrics}} over the files."""
+             use_mag: bool = True, progress: bool = True, start_in_movement: float | None = None) -> dict:
+    """{"recordings": {name: {label: metrics}}, "mean": {label: metrics}} over the files;
+    start_in_movement (s): cut each recording to begin that long into its movement phase."""
     recordings = {}
     for i, path in enumerate(paths):
         if progress:
@@ -60,6 +61,8 @@ def evaluate(paths, method: str = "wiener", params=None, offline: bool = False, 
             print(f"\revaluate [{'#' * done}{'.' * (20 - done)}] {i + 1}/{len(paths)} {path}",
                   end="" if sys.stderr.isatty() else "\n", file=sys.stderr, flush=True)
         rec = read_recording(path)
+        if start_in_movement is not None:
+            rec = rec.into_movement(start_in_movement)
         recordings[rec.name] = evaluate_recording(rec, method, params, offline, gyro_offset, use_mag)
     if progress and sys.stderr.isatty():
         print(file=sys.stderr)

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import csv
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -38,6 +38,20 @@ class Recording:
     mag: np.ndarray | None = None
     quat_ref: np.ndarray | None = None
     movement: np.ndarray | None = None
+
+    def into_movement(self, seconds: float) -> Recording:
+        """The recording from `seconds` (≥ 0) after its movement phase begins: no rest
+        before it and a first sample in motion."""
+        if self.movement is None or not self.movement.any():
+            raise RecordingError(f"{self.name}: no movement phase to start in")
+        if not (math.isfinite(seconds) and seconds >= 0):
+            raise RecordingError(f"start in the movement phase must be a finite non-negative time, got {seconds!r}")
+        k = int(np.argmax(self.movement)) + int(round(seconds * self.fs))
+        if k >= len(self.gyr):
+            raise RecordingError(f"{self.name}: the recording ends before {seconds:g} s into its movement phase")
+        cut = lambda a: None if a is None else a[k:]
+        return replace(self, gyr=self.gyr[k:], acc=self.acc[k:], t=self.t[k:], mag=cut(self.mag),
+                       quat_ref=cut(self.quat_ref), movement=cut(self.movement))
 
 
 def read_recording(path, fs: float | None = None, gyr_unit: str = "rad/s", acc_unit: str = "m/s2") -> Recording:

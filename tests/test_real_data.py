@@ -17,7 +17,9 @@ from systems import experiments as ex
 from systems.batch import estimate
 from systems.cli import main
 from systems.errors import inclination_error, quaternion_errors, rms
+from systems.evaluate import evaluate_recording
 from systems.motion import PROFILES, ClosedFormMotion, HumanMotion
+from systems.recording import read_recording
 from systems.sensor_model import ImuModel
 from tests.interpreted import interpreted_json
 
@@ -161,6 +163,13 @@ def test_evaluate_json_contract_on_synthetic_recordings(tmp_path, capsys):
     assert result["mean"]["wiener"]["inclination_rmse_deg"] < 0.5
     assert main(["evaluate", "--json", "--offline", str(tmp_path / "a.mat")]) == 0
     assert "wiener_offline" in json.loads(capsys.readouterr().out)["mean"]
+    # --start-in-movement: the same figures as on the recording cut there (movement from index 501)
+    assert main(["evaluate", "--json", "--start-in-movement", "2", str(tmp_path / "a.mat")]) == 0
+    cut = read_recording(tmp_path / "a.mat").into_movement(2.0)
+    assert len(cut.gyr) == len(motion.gyr) - 501 - 200
+    assert json.loads(capsys.readouterr().out)["recordings"]["a"] == evaluate_recording(cut)
+    assert main(["evaluate", "--start-in-movement", "100", str(tmp_path / "a.mat")]) == 2
+    assert "ends before 100 s into its movement phase" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize("case", ["no reference", "no movement flag", "corrupted"])
@@ -205,6 +214,22 @@ def test_magnetometer_heading_follows_the_field_and_survives_a_disturbance():
     assert est.mag_accepted[20000:30000].mean() < 0.2 and est.mag_accepted[31000:].all()
     assert heading[20000:30000].max() < 30.0  # about the gyro's 0.2 °/s over 100 s, not the field's pull
     assert heading[40000:].max() < 3.0
+
+
+def test_heading_and_tilt_start_in_motion():
+    """A recording whose first samples are in vigorous motion (the first accelerometer
+    sample is 28° off the vertical): the start-up means of the tilt filter and of the
+    heading estimator settle, and no disturbance guard locks onto the bad start."""
+    motion = HumanMotion(delta_v=1.0).generate(200.0, FS, seed=1)
+    gyr, acc = ImuModel(delta_n=math.radians(0.05), acc_noise=0.002).apply(motion, seed=6)
+    start = int(30 * FS)  # cut into the motion
+    est = estimate(gyr[start:], acc[start:], FS, mag=motion.mag[start:])
+    _, heading, inclination = (np.degrees(e) for e in quaternion_errors(est.quat, motion.quat[start:]))
+    settled = int(30 * FS)
+    assert inclination[0] > 20.0
+    print(f"after 30 s: heading RMS {rms(heading[settled:]):.2f}°, inclination RMS {rms(inclination[settled:]):.2f}°")
+    assert rms(heading[settled:]) < 1.0
+    assert rms(inclination[settled:]) < 1.0
 
 
 def test_plot_writes_a_png_and_refuses_a_recording_without_reference(tmp_path, capsys):
