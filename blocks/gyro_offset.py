@@ -32,6 +32,7 @@ import numpy as np
 from .jit import kernel
 from .methods import Param, resolve_params
 from .quaternion import quat_multiply, quat_normalized, quat_rotate, rotvec_quat
+from .sensor_frame import time_reversed
 from .wiener_local import butterworth_zoh
 
 PARAMS = (
@@ -133,8 +134,9 @@ def motion_update(b, P, old, new, r_lp, rb_lp, Ts, W, clip):
 
 
 @kernel()
-def run(state, coef, gyr, acc, corrected, offset):
-    """Over N samples: corrected gyro (N×3, rad/s) and offset estimate (N×3) per sample."""
+def run(state, coef, gyr, acc, corrected, offset, variance):
+    """Over N samples: corrected gyro (N×3, rad/s), offset estimate (N×3) and its
+    variance per axis (N×3, (rad/s)²) per sample."""
     Ts, a_lp, a_bias, rest_gyr, rest_gyr_abs, rest_acc, rest_time, wt, P0, V, W = (
         coef[0], coef[1], coef[2], coef[3], coef[4], coef[5], coef[6], coef[7], coef[8], coef[9], coef[10])
     settle = 3.0 * math.sqrt(2.0) * Ts / wt  # 3·τ_acc
@@ -186,14 +188,27 @@ def run(state, coef, gyr, acc, corrected, offset):
             motion_update(b, P, old, acc_lp[0], r_lp[0], rb_lp[0], Ts, W, clip)
         for i in range(3):
             offset[k, i] = b[i]
+            variance[k, i] = P[i, i]
 
 
-def correct(gyr, acc, fs: float, params=None):
-    """(corrected gyro, offset estimate), both N×3 rad/s, over a whole recording."""
+def correct(gyr, acc, fs: float, params=None, offline: bool = False):
+    """(corrected gyro, offset estimate), both N×3 rad/s, over a whole recording. offline:
+    the estimates of a forward and a backward pass in time (whose gyro is
+    blocks.sensor_frame.time_reversed, its offset the negative), each axis weighted by
+    the inverse of its pass's variance: every sample's offset from all rests and motion."""
     gyr = np.ascontiguousarray(gyr, dtype=float)
     acc = np.ascontiguousarray(acc, dtype=float)
     coef = coefficients(resolve(params), 1.0 / fs)
-    state = initial_state(coef, gyr[0], acc[0])
-    corrected, offset = np.empty_like(gyr), np.empty_like(gyr)
-    run(state, coef, gyr, acc, corrected, offset)
-    return corrected, offset
+
+    def one_pass(g, a):
+        state = initial_state(coef, g[0], a[0])
+        corrected, offset, variance = np.empty_like(g), np.empty_like(g), np.empty_like(g)
+        run(state, coef, g, a, corrected, offset, variance)
+        return offset, variance
+
+    offset, variance = one_pass(gyr, acc)
+    if offline:
+        back, back_variance = one_pass(time_reversed(gyr), np.ascontiguousarray(acc[::-1]))
+        weight = back_variance[::-1] / (variance + back_variance[::-1])
+        offset = weight * offset - (1.0 - weight) * back[::-1]
+    return gyr - offset, offset

@@ -181,6 +181,12 @@ def sensor_frame_system(earth_filter, dt: float | None = None, name: str = "esti
     return stepper_system(SensorFrameStepper(DiscreteFilter.from_lti(earth_filter, dt)), dt, name)
 
 
+def time_reversed(gyr) -> np.ndarray:
+    """Gyro (N×3, rad/s) for a pass backward in time: the step from sample k+1 to k turns
+    the frame back by gyr[k+1] (row 0, before the first step, is 0)."""
+    return np.vstack([np.zeros((1, 3)), -np.asarray(gyr)[:0:-1]])
+
+
 def start_gravity(gyr0, acc0, Ts: float) -> np.ndarray:
     """The gravity to start at rest on, before the first sample: acc0 (m/s², measured at the
     end of the first interval) turned back by that interval's rotation gyr0·Ts (rad), so

@@ -12,7 +12,7 @@ from scipy.spatial.transform import Rotation
 from blocks.gyro_offset import correct as correct_gyro
 from blocks.heading import with_magnetometer
 from blocks.methods import METHODS, KernelStepper, method as get_method, stepper
-from blocks.sensor_frame import start_gravity
+from blocks.sensor_frame import start_gravity, time_reversed
 
 
 @dataclass
@@ -65,14 +65,15 @@ def estimate(
     the first gyro sample (blocks.sensor_frame.start_gravity). offline: the method's earth-frame filter
     forward, then backward over the forward estimate (for `wiener` the non-causal Wiener
     smoother, see blocks.accuracy.smoother_mean_square_gravity_error). gyro_offset: first
-    estimate the gyro offset at rest and remove it (blocks.gyro_offset; the estimate is
-    returned as `offset`). mag (N×3, µT): heading from the magnetometer with a guard
+    estimate the gyro offset at rest and while moving and remove it (blocks.gyro_offset;
+    offline from passes forward and backward in time; the estimate is returned as
+    `offset`). mag (N×3, µT): heading from the magnetometer with a guard
     against disturbances (blocks.heading); without it the heading is the gyro's (6D).
     """
     gyr, acc = check_imu(gyr, acc, fs)
     offset = None
     if gyro_offset:
-        gyr, offset = correct_gyro(gyr, acc, fs)
+        gyr, offset = correct_gyro(gyr, acc, fs, offline=offline)
     step = stepper(method, tuple(sorted((params or {}).items())), 1.0 / fs)
     if initial_gravity is None:
         initial_gravity = start_gravity(gyr[0], acc[0], 1.0 / fs)
@@ -83,7 +84,7 @@ def estimate(
     if not get_method(method).is_sensor_frame:
         raise ValueError(f"offline smoothing needs an earth-frame filter method "
                          f"({', '.join(n for n, m in METHODS.items() if m.is_sensor_frame)}), not {method!r}")
-    gyr_back = _backward(gyr)
+    gyr_back = time_reversed(gyr)
     if isinstance(step, KernelStepper):
         # wiener's local densities: both passes run at the lower of the break frequencies
         # estimated causally forward and backward in time
@@ -96,12 +97,6 @@ def estimate(
         backward = _run(step, gyr_back, np.ascontiguousarray(forward.gravity[::-1]), forward.gravity[-1]).gravity
     gravity = backward[::-1].copy()
     return _with_heading(AttitudeEstimate(gravity, level_onto(forward.quat, gravity), offset), mag, fs)
-
-
-def _backward(gyr) -> np.ndarray:
-    """Gyro for a pass backward in time: the step from sample k+1 to k turns the frame
-    back by gyr[k+1]."""
-    return np.vstack([np.zeros((1, 3)), -gyr[:0:-1]])
 
 
 def _run_local(step, gyr, acc, initial_gravity, omega=None):
