@@ -20,8 +20,8 @@ c. Guards, all from the same model:
 - innovations are clipped at 4·sigma_init, the fastest turn a plausible offset makes;
 - no update in the first 3·tau_acc, while the low-pass forgets its first sample.
 A rest phase replaces the estimate by the rest average and its variance shrinks with
-the old estimate's weight. The corrected gyro is the measured one minus the current
-estimate. Causal, one compiled step per sample.
+the old estimate's weight. The corrected gyro is the measured one minus the estimate
+after its sample. Causal, one compiled step per sample.
 """
 from __future__ import annotations
 
@@ -134,9 +134,9 @@ def motion_update(b, P, old, new, r_lp, rb_lp, Ts, W, clip):
 
 
 @kernel()
-def run(state, coef, gyr, acc, corrected, offset, variance):
-    """Over N samples: corrected gyro (N×3, rad/s), offset estimate (N×3) and its
-    variance per axis (N×3, (rad/s)²) per sample."""
+def run(state, coef, gyr, acc, offset, variance):
+    """Over N samples: the offset estimate after each sample (N×3, rad/s) and its variance
+    per axis (N×3, (rad/s)²)."""
     Ts, a_lp, a_bias, rest_gyr, rest_gyr_abs, rest_acc, rest_time, wt, P0, V, W = (
         coef[0], coef[1], coef[2], coef[3], coef[4], coef[5], coef[6], coef[7], coef[8], coef[9], coef[10])
     settle = 3.0 * math.sqrt(2.0) * Ts / wt  # 3·τ_acc
@@ -160,11 +160,9 @@ def run(state, coef, gyr, acc, corrected, offset, variance):
             g2 += state[i] ** 2
         still = dg2 < rest_gyr * rest_gyr and da2 < rest_acc * rest_acc and g2 < rest_gyr_abs * rest_gyr_abs
         state[6] = state[6] + Ts if still else 0.0
-        for i in range(3):
-            corrected[k, i] = gyr[k, i] - b[i]
-        q = quat_normalized(quat_multiply(
+        q = quat_normalized(quat_multiply(  # the gyro frame turned by the corrected gyro
             (state[11], state[12], state[13], state[14]),
-            rotvec_quat(corrected[k, 0] * Ts, corrected[k, 1] * Ts, corrected[k, 2] * Ts)))
+            rotvec_quat((gyr[k, 0] - b[0]) * Ts, (gyr[k, 1] - b[1]) * Ts, (gyr[k, 2] - b[2]) * Ts)))
         state[11], state[12], state[13], state[14] = q
         state[T] += Ts
         # the accelerometer, R·b and R (column j: the sensor's axis j) low-passed in the gyro frame
@@ -202,8 +200,8 @@ def correct(gyr, acc, fs: float, params=None, offline: bool = False):
 
     def one_pass(g, a):
         state = initial_state(coef, g[0], a[0])
-        corrected, offset, variance = np.empty_like(g), np.empty_like(g), np.empty_like(g)
-        run(state, coef, g, a, corrected, offset, variance)
+        offset, variance = np.empty_like(g), np.empty_like(g)
+        run(state, coef, g, a, offset, variance)
         return offset, variance
 
     offset, variance = one_pass(gyr, acc)

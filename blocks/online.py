@@ -7,6 +7,10 @@ from typing import Mapping
 
 import numpy as np
 
+from .gyro_offset import coefficients as offset_coefficients
+from .gyro_offset import initial_state as offset_initial_state
+from .gyro_offset import resolve as offset_resolve
+from .gyro_offset import run as offset_run
 from .heading import coefficients as heading_coefficients
 from .heading import heading_step
 from .heading import initial_state as heading_initial_state
@@ -68,17 +72,22 @@ class OnlineEstimator:
 
     method and params as for `attitude estimate`; they are validated here. Inputs go to
     io[0:6] (and the magnetometer to io[16:19] with heading=True: blocks.heading, as the
-    batch path's mag argument), outputs come from io[6:16] (see IO_*). The filter starts
-    at rest on the first accelerometer sample with non-zero norm, as the batch path
-    starts on its first sample; until then `ready` is False.
+    batch path's mag argument), outputs come from io[6:16] (see IO_*). gyro_offset=True:
+    the gyro offset is estimated and removed first (blocks.gyro_offset, as the batch
+    path's gyro_offset argument). The filter starts at rest on the first accelerometer
+    sample with non-zero norm, as the batch path starts on its first sample; until then
+    `ready` is False.
     """
 
-    def __init__(self, method: str = "wiener", params: Mapping[str, float] | None = None, heading: bool = False):
+    def __init__(self, method: str = "wiener", params: Mapping[str, float] | None = None, heading: bool = False,
+                 gyro_offset: bool = False):
         m = get_method(method)
         m.runs_kernel(m.resolve(params))  # refuse unknown methods and bad parameters now
         self.method = method
         self.params = tuple(sorted((params or {}).items()))
         self.heading = heading
+        self.gyro_offset = gyro_offset
+        self.offset = np.zeros((2, 3))  # offset estimate (rad/s) and its variance ((rad/s)²)
         self.io = np.zeros(19)
         self._Ts = None
         self.reset()
@@ -111,11 +120,21 @@ class OnlineEstimator:
             self._stepper, self._Ts = stepper(self.method, self.params, Ts), Ts
             self.sensor_frame = isinstance(self._stepper, SensorFrameStepper)
             self._heading_coef = heading_coefficients(heading_resolve(), Ts)
+            self._offset_coef = offset_coefficients(offset_resolve(), Ts)
 
         if self.state is None:
             acc = self.io[3:6]
             if not (np.isfinite(self.io[IO_INPUTS]).all() and np.any(acc)):
                 return False
+            self._offset_state = offset_initial_state(self._offset_coef, self.io[0:3], acc)
+        if self.gyro_offset:
+            if not np.isfinite(self.io[IO_INPUTS]).all():
+                return False
+            rows = self.io[0:6].reshape(2, 3)
+            offset_run(self._offset_state, self._offset_coef, rows[0:1], rows[1:2], self.offset[0:1], self.offset[1:2])
+            self.io[0:3] -= self.offset[0]
+        if self.state is None:
+            acc = self.io[3:6]
             self.state = self._stepper.initial_state(start_gravity(self.io[0:3], acc, Ts))
             if self.sensor_frame:  # views of the state and scratch space, made once
                 n = self._stepper.disc.order

@@ -40,6 +40,7 @@ class AttitudeEstimator(ProjectSlave):
         self.boolean_output("valid", False, "an estimate is available and the last inputs were finite")
         self.parameter("method", "wiener", f"estimator: {', '.join(METHODS)}")
         self.parameter("heading", "mag", "heading source: mag (magnetometer, guarded against disturbances) or gyro")
+        self.parameter("gyro_offset", "off", "on: estimate and remove the gyro offset (at rest and while moving); off")
         self.real("Ts", 0.01, "s", "sample time the estimator expects (other step sizes are re-discretised)", PAR)
         for name, (unit, doc) in tuning_parameters().items():
             self.real(name, 0.0, unit, doc, PAR)
@@ -53,9 +54,13 @@ class AttitudeEstimator(ProjectSlave):
         if self.heading not in ("mag", "gyro"):
             self.fail(f"invalid parameter: heading must be 'mag' or 'gyro', got {self.heading!r}")
             return
+        if self.gyro_offset not in ("on", "off"):
+            self.fail(f"invalid parameter: gyro_offset must be 'on' or 'off', got {self.gyro_offset!r}")
+            return
         params = {name: getattr(self, name) for name in tuning_parameters() if getattr(self, name) != 0.0}
         try:
-            self.estimator = OnlineEstimator(self.method, params, heading=self.heading == "mag")
+            self.estimator = OnlineEstimator(self.method, params, heading=self.heading == "mag",
+                                             gyro_offset=self.gyro_offset == "on")
         except ValueError as exc:
             self.fail(f"invalid parameter: {exc}")
 
