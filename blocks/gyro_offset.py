@@ -59,6 +59,9 @@ STATE_NAMES = (
     *(f"P_{i}{j}" for i in "xyz" for j in "xyz"),  # covariance of the offset estimate, (rad/s)²
 )
 T, QUAT, ACC_LP, R_LP, RB_LP, COV = 10, slice(11, 15), slice(15, 21), slice(21, 39), slice(39, 45), slice(45, 54)
+OBSERVED = 0.5  # the least share of an offset's effect H must keep in a direction to update it
+CLIP_SIGMAS = 4.0  # innovations clipped at this many sigma_init
+SETTLE_TAUS = 3.0  # no update before this many tau_acc (the low-pass forgetting its start)
 
 
 def resolve(overrides=None) -> dict:
@@ -124,7 +127,7 @@ def motion_update(b, P, old, new, r_lp, rb_lp, Ts, W, clip):
     e = np.minimum(np.maximum(turn + across(rb_lp, new, n2) - H @ b, -clip), clip)
     # only the directions H keeps at least half of
     U, sv, Vt = np.linalg.svd(H)
-    kept = (sv >= 0.5).astype(np.float64)
+    kept = (sv >= OBSERVED).astype(np.float64)
     Uk = U * kept
     Hk = (Uk * sv) @ Vt
     PHt = P @ Hk.T
@@ -139,8 +142,8 @@ def run(state, coef, gyr, acc, offset, variance):
     per axis (N×3, (rad/s)²)."""
     Ts, a_lp, a_bias, rest_gyr, rest_gyr_abs, rest_acc, rest_time, wt, P0, V, W = (
         coef[0], coef[1], coef[2], coef[3], coef[4], coef[5], coef[6], coef[7], coef[8], coef[9], coef[10])
-    settle = 3.0 * math.sqrt(2.0) * Ts / wt  # 3·τ_acc
-    clip = 4.0 * math.sqrt(P0)
+    settle = SETTLE_TAUS * math.sqrt(2.0) * Ts / wt
+    clip = CLIP_SIGMAS * math.sqrt(P0)
     Ad, Bd = np.empty((2, 2)), np.empty(2)
     butterworth_zoh(wt, Ad, Bd)
     b = state[7:10]
