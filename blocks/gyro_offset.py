@@ -163,22 +163,23 @@ def run(state, coef, gyr, acc, offset, variance):
             g2 += state[i] ** 2
         still = dg2 < rest_gyr * rest_gyr and da2 < rest_acc * rest_acc and g2 < rest_gyr_abs * rest_gyr_abs
         state[6] = state[6] + Ts if still else 0.0
-        q = quat_normalized(quat_multiply(  # the gyro frame turned by the corrected gyro
-            (state[11], state[12], state[13], state[14]),
-            rotvec_quat((gyr[k, 0] - b[0]) * Ts, (gyr[k, 1] - b[1]) * Ts, (gyr[k, 2] - b[2]) * Ts)))
-        state[11], state[12], state[13], state[14] = q
-        state[T] += Ts
-        # the accelerometer, R·b and R (column j: the sensor's axis j) low-passed in the gyro frame
         old = acc_lp[0].copy()
-        a = quat_rotate(q, (acc[k, 0], acc[k, 1], acc[k, 2]))
-        rb = quat_rotate(q, (b[0], b[1], b[2]))
-        for i in range(3):
-            lowpass_step(acc_lp, i, a[i], Ad, Bd)
-            lowpass_step(rb_lp, i, rb[i], Ad, Bd)
-        for j in range(3):
-            col = quat_rotate(q, (1.0 if j == 0 else 0.0, 1.0 if j == 1 else 0.0, 1.0 if j == 2 else 0.0))
+        if V > 0.0:  # tracking while moving: the gyro frame and its low-passes
+            q = quat_normalized(quat_multiply(  # turned by the corrected gyro
+                (state[11], state[12], state[13], state[14]),
+                rotvec_quat((gyr[k, 0] - b[0]) * Ts, (gyr[k, 1] - b[1]) * Ts, (gyr[k, 2] - b[2]) * Ts)))
+            state[11], state[12], state[13], state[14] = q
+            state[T] += Ts
+            # the accelerometer, R·b and R (column j: the sensor's axis j) low-passed
+            a = quat_rotate(q, (acc[k, 0], acc[k, 1], acc[k, 2]))
+            rb = quat_rotate(q, (b[0], b[1], b[2]))
             for i in range(3):
-                lowpass_step(r_lp, 3 * i + j, col[i], Ad, Bd)
+                lowpass_step(acc_lp, i, a[i], Ad, Bd)
+                lowpass_step(rb_lp, i, rb[i], Ad, Bd)
+            for j in range(3):
+                col = quat_rotate(q, (1.0 if j == 0 else 0.0, 1.0 if j == 1 else 0.0, 1.0 if j == 2 else 0.0))
+                for i in range(3):
+                    lowpass_step(r_lp, 3 * i + j, col[i], Ad, Bd)
         for i in range(3):
             P[i, i] = min(P[i, i] + V, P0)
         if state[6] >= rest_time:

@@ -120,22 +120,23 @@ class OnlineEstimator:
             self._stepper, self._Ts = stepper(self.method, self.params, Ts), Ts
             self.sensor_frame = isinstance(self._stepper, SensorFrameStepper)
             self._heading_coef = heading_coefficients(heading_resolve(), Ts)
-            self._offset_coef = offset_coefficients(offset_resolve(), Ts)
+            if self.gyro_offset:
+                self._offset_coef = offset_coefficients(offset_resolve(), Ts)
 
-        if self.state is None:
-            acc = self.io[3:6]
-            if not (np.isfinite(self.io[IO_INPUTS]).all() and np.any(acc)):
+        starting = self.state is None
+        if starting:
+            if not (np.isfinite(self.io[IO_INPUTS]).all() and np.any(self.io[3:6])):
                 return False
-            self._offset_state = offset_initial_state(self._offset_coef, self.io[0:3], acc)
-        if self.gyro_offset:
+            if self.gyro_offset:
+                self._offset_state = offset_initial_state(self._offset_coef, self.io[0:3], self.io[3:6])
+        if self.gyro_offset:  # the offset estimate after this sample, removed from the gyro
             if not np.isfinite(self.io[IO_INPUTS]).all():
                 return False
             rows = self.io[0:6].reshape(2, 3)
             offset_run(self._offset_state, self._offset_coef, rows[0:1], rows[1:2], self.offset[0:1], self.offset[1:2])
             self.io[0:3] -= self.offset[0]
-        if self.state is None:
-            acc = self.io[3:6]
-            self.state = self._stepper.initial_state(start_gravity(self.io[0:3], acc, Ts))
+        if starting:
+            self.state = self._stepper.initial_state(start_gravity(self.io[0:3], self.io[3:6], Ts))
             if self.sensor_frame:  # views of the state and scratch space, made once
                 n = self._stepper.disc.order
                 self._views = (self.state[: 3 * n].reshape(n, 3), self.state[3 * n:], np.empty((n, 3)))

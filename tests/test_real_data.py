@@ -155,10 +155,9 @@ def test_offset_estimator_compiled_equals_its_plain_python_source():
 
 def _offset_case():
     """5 s at rest, then 35 s of motion, with a gyro offset: both branches of the estimator."""
-    motion = HumanMotion(delta_v=0.25).generate(35.0, FS, seed=2)
-    gyr, acc = ImuModel(delta_n=math.radians(0.02), acc_noise=0.002, gyr_offset=(0.01, -0.02, 0.005)).apply(motion, 3)
-    rest_gyr, rest_acc = ImuModel(delta_n=math.radians(0.02), acc_noise=0.002, gyr_offset=(0.01, -0.02, 0.005)).apply(
-        HumanMotion(delta_v=1e-12, rot_rms=0.0).generate(5.0, FS, seed=4), 5)
+    imu = ImuModel(delta_n=math.radians(0.02), acc_noise=0.002, gyr_offset=(0.01, -0.02, 0.005))
+    gyr, acc = imu.apply(HumanMotion(delta_v=0.25).generate(35.0, FS, seed=2), 3)
+    rest_gyr, rest_acc = imu.apply(HumanMotion(delta_v=1e-12, rot_rms=0.0).generate(5.0, FS, seed=4), 5)
     return np.vstack([rest_gyr, gyr]), np.vstack([rest_acc, acc])
 
 
