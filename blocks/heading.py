@@ -11,7 +11,14 @@ with the weight 1/n of a running mean, and the reference norm and dip are their 
 means (the first samples may come in motion, while the tilt is still settling). Then
 the guard against magnetic disturbances: a sample is used only while the field's norm
 and dip stay within tolerance of the reference, which is tracked slowly (tau_reference)
-over accepted samples; otherwise the heading is the gyro's.
+over accepted samples; otherwise the heading is the gyro's. A new reference: a field
+outside the reference's tolerance that stays steady (norm and dip within the same
+tolerances of their own running mean) for mag_new_time while the sensor turns through
+mag_new_angle is taken as proven: the estimator starts afresh from it, with the
+start-up's running means. A homogeneous field keeps its norm and dip when the
+sensor turns, a field fixed to the sensor (a magnet carried along) does not, so a wrong
+reference from a disturbed start, or a move to a place whose field differs (another
+room or building), no longer locks the magnetometer out for good.
 Inclination is untouched: the correction turns about the vertical only.
 """
 from __future__ import annotations
@@ -30,7 +37,11 @@ PARAMS = (
     Param("mag_dip_tol", math.radians(5.0), "rad", "largest deviation of the dip angle from its reference"),
     Param("tau_reference", 60.0, "s", "time constant of the reference norm and dip"),
     Param("heading_clip", math.radians(10.0), "rad", "largest heading innovation one sample may use"),
+    Param("mag_new_time", 20.0, "s", "how long a field outside the reference's tolerance must stay steady to replace it"),
+    Param("mag_new_angle", math.radians(90.0), "rad", "how far the sensor must turn meanwhile (0: no turn)", True),
 )
+REF_NORM, REF_DIP, SEEN = 1, 2, 3
+CAND_NORM, CAND_DIP, CAND_N, CAND_DOT, CAND_Q0 = 4, 5, 6, 7, 8  # q₀ in 8…11
 
 
 def resolve(overrides=None) -> dict:
@@ -38,14 +49,49 @@ def resolve(overrides=None) -> dict:
 
 
 def coefficients(params, Ts: float) -> np.ndarray:
-    """[a_heading, a_reference, mag_norm_tol, mag_dip_tol, heading_clip]; a_* = 1 − exp(−Ts/τ)."""
+    """[a_heading, a_reference, mag_norm_tol, mag_dip_tol, heading_clip, samples a new
+    field must stay steady, cos(mag_new_angle/2)]; a_* = 1 − exp(−Ts/τ)."""
     return np.array([1.0 - math.exp(-Ts / params["tau_heading"]), 1.0 - math.exp(-Ts / params["tau_reference"]),
-                     params["mag_norm_tol"], params["mag_dip_tol"], params["heading_clip"]])
+                     params["mag_norm_tol"], params["mag_dip_tol"], params["heading_clip"],
+                     params["mag_new_time"] / Ts, math.cos(0.5 * params["mag_new_angle"])])
 
 
 def initial_state() -> np.ndarray:
-    """[ψ_c (rad), reference norm, reference dip (rad), samples seen with a field]."""
-    return np.array([0.0, 0.0, 0.0, 0.0])
+    """[ψ_c (rad), reference norm, reference dip (rad), samples seen with a field,
+    candidate norm, candidate dip (rad), samples in the candidate, smallest |q·q₀| since
+    the candidate began, q₀ (4, the orientation then)]."""
+    state = np.zeros(12)
+    state[CAND_DOT] = 1.0
+    return state
+
+
+@kernel(inline=True)
+def _steady(norm, dip, ref_norm, ref_dip, norm_tol, dip_tol):
+    return abs(norm - ref_norm) <= norm_tol * ref_norm and abs(dip - ref_dip) <= dip_tol
+
+
+@kernel(inline=True)
+def _new_reference(state, coef, q, norm, dip):
+    """A sample outside the reference's tolerance: extend the candidate field (or begin one
+    at this sample); True when the candidate has stayed steady for mag_new_time while the
+    sensor turned through mag_new_angle: the heading estimator then starts afresh."""
+    norm_tol, dip_tol, samples, cos_half = coef[2], coef[3], coef[5], coef[6]
+    if state[CAND_N] > 0.0 and _steady(norm, dip, state[CAND_NORM], state[CAND_DIP], norm_tol, dip_tol):
+        state[CAND_N] += 1.0
+        state[CAND_NORM] += (norm - state[CAND_NORM]) / state[CAND_N]
+        state[CAND_DIP] += (dip - state[CAND_DIP]) / state[CAND_N]
+        dot = 0.0
+        for i in range(4):
+            dot += q[i] * state[CAND_Q0 + i]
+        state[CAND_DOT] = min(state[CAND_DOT], abs(dot))
+        if state[CAND_N] >= samples and state[CAND_DOT] <= cos_half:
+            state[CAND_N] = 0.0
+            return True
+        return False
+    state[CAND_NORM], state[CAND_DIP], state[CAND_N], state[CAND_DOT] = norm, dip, 1.0, 1.0
+    for i in range(4):
+        state[CAND_Q0 + i] = q[i]
+    return False
 
 
 @kernel(inline=True)
@@ -60,17 +106,23 @@ def heading_step(state, coef, q, m_sensor):
     ok = False
     if norm > 0.0 and horizontal > 0.0:
         dip = math.atan2(-m[2], horizontal)
-        state[3] += 1.0
-        if 1.0 / state[3] > a_heading:  # start-up: running means, every sample
+        state[SEEN] += 1.0
+        start = 1.0 / state[SEEN] > a_heading
+        if not start:
+            ok = _steady(norm, dip, state[REF_NORM], state[REF_DIP], norm_tol, dip_tol)
+            if ok:
+                state[CAND_N] = 0.0
+            elif _new_reference(state, coef, q, norm, dip):
+                state[SEEN], start = 1.0, True  # a proven field: start afresh from it
+        if start:  # running means, every sample
             ok = True
-            state[0] += math.atan2(m[0], m[1]) / state[3]
-            state[1] += (norm - state[1]) / state[3]
-            state[2] += (dip - state[2]) / state[3]
-        elif abs(norm - state[1]) <= norm_tol * state[1] and abs(dip - state[2]) <= dip_tol:
-            ok = True
+            state[0] += math.atan2(m[0], m[1]) / state[SEEN]
+            state[REF_NORM] += (norm - state[REF_NORM]) / state[SEEN]
+            state[REF_DIP] += (dip - state[REF_DIP]) / state[SEEN]
+        elif ok:
             state[0] += a_heading * min(clip, max(-clip, math.atan2(m[0], m[1])))
-            state[1] += a_reference * (norm - state[1])
-            state[2] += a_reference * (dip - state[2])
+            state[REF_NORM] += a_reference * (norm - state[REF_NORM])
+            state[REF_DIP] += a_reference * (dip - state[REF_DIP])
     state[0] = math.atan2(math.sin(state[0]), math.cos(state[0]))
     half = 0.5 * state[0]
     return quat_multiply((math.cos(half), 0.0, 0.0, math.sin(half)), q), ok

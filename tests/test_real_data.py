@@ -13,13 +13,14 @@ from scipy.spatial.transform import Rotation
 from blocks import accuracy as ac
 from blocks import earth_filters as ef
 from blocks.gyro_offset import correct as correct_gyro
+from blocks.heading import with_magnetometer
 from systems import experiments as ex
 from systems.batch import estimate
 from systems.cli import main
 from systems.errors import inclination_error, quaternion_errors, rms
 from systems.compare import peer_quaternions
 from systems.evaluate import evaluate_recording
-from systems.motion import PROFILES, ClosedFormMotion, HumanMotion
+from systems.motion import EARTH_FIELD_UT, PROFILES, ClosedFormMotion, HumanMotion
 from systems.recording import read_recording
 from systems.sensor_model import ImuModel
 from tests.interpreted import interpreted_json
@@ -220,12 +221,20 @@ def test_quaternion_errors_split_heading_from_inclination():
     assert np.allclose(heading, 0.3) and np.allclose(inclination, 0.0, atol=1e-7) and np.allclose(total, 0.3)
 
 
-def test_magnetometer_heading_follows_the_field_and_survives_a_disturbance():
+def _turns_with_field(earth_field=None):
+    """600 s of turning (heading ±86°, tilt ±29°) with a 0.2 °/s gyro offset about z:
+    (motion, gyr, acc, magnetometer with 0.5 µT noise). earth_field (N×3, µT, ENU) is the
+    field where the sensor is, by default the homogeneous EARTH_FIELD_UT."""
     turns = ClosedFormMotion("turns", lambda t: Rotation.from_euler("ZYX", np.column_stack([
         1.5 * np.sin(0.2 * t) + 0.3, 0.5 * np.sin(0.3 * t), 0.4 * np.sin(0.5 * t)])), lambda t: np.zeros((len(t), 3)))
     motion = turns.generate(600.0, FS)
     gyr, acc = ImuModel(delta_n=math.radians(0.05), gyr_offset=(0.0, 0.0, math.radians(0.2))).apply(motion, seed=1)
-    mag = motion.mag + np.random.default_rng(2).normal(0, 0.5, motion.mag.shape)
+    ideal = motion.mag if earth_field is None else Rotation.from_quat(motion.quat, scalar_first=True).inv().apply(earth_field)
+    return motion, gyr, acc, ideal + np.random.default_rng(2).normal(0, 0.5, ideal.shape)
+
+
+def test_magnetometer_heading_follows_the_field_and_survives_a_disturbance():
+    motion, gyr, acc, mag = _turns_with_field()
     heading_of = lambda est: np.degrees(quaternion_errors(est.quat, motion.quat)[1])
     gyro_only, with_mag = estimate(gyr, acc, FS), estimate(gyr, acc, FS, mag=mag)
     assert heading_of(gyro_only)[-1] > 45.0  # the gyro's heading walks off
@@ -240,6 +249,47 @@ def test_magnetometer_heading_follows_the_field_and_survives_a_disturbance():
     assert est.mag_accepted[20000:30000].mean() < 0.2 and est.mag_accepted[31000:].all()
     assert heading[20000:30000].max() < 30.0  # about the gyro's 0.2 °/s over 100 s, not the field's pull
     assert heading[40000:].max() < 3.0
+
+
+@pytest.mark.parametrize("case", ["disturbed start", "another field from 200 s"])
+def test_heading_takes_a_new_field_that_stays_steady_while_the_sensor_turns(case):
+    """A wrong reference (the first 30 s next to an earth-fixed disturbance of 31 µT) or a
+    move to a place whose field differs (norm −15 %, dip +7°, north unchanged): the guard
+    would refuse the true field for good; the new field, steady for mag_new_time (20 s)
+    while the sensor turns, becomes the reference and the heading follows it again."""
+    earth = np.tile(EARTH_FIELD_UT, (int(600 * FS), 1)).astype(float)
+    change = int(30 * FS) if case == "disturbed start" else int(200 * FS)
+    if case == "disturbed start":
+        earth[:change] += [25.0, -10.0, 15.0]
+    else:
+        earth[change:] = [0.0, 12.0, -38.0]
+    motion, gyr, acc, mag = _turns_with_field(earth)
+    est = estimate(gyr, acc, FS, mag=mag, gyro_offset=True)
+    heading = np.degrees(quaternion_errors(est.quat, motion.quat)[1])
+    proven = change + int(25 * FS)  # mag_new_time and a few seconds of averaging later
+    print(f"{case}: heading from {proven / FS:.0f} s max {heading[proven:].max():.2f}°, "
+          f"accepted {est.mag_accepted[proven:].mean():.3f}")
+    assert est.mag_accepted[proven:].all()
+    assert heading[proven:].max() < 3.0
+
+
+def test_a_new_field_needs_the_sensor_to_turn():
+    """A field fixed to the sensor (a magnet carried along, 30 µT for the last 400 s of the
+    turning) changes its norm and dip as the sensor turns: never taken as the reference,
+    the output equals that of an estimator that never takes one. A steady new field at a
+    sensor that does not turn is refused as well, until mag_new_angle asks for no turn."""
+    motion, gyr, acc, mag = _turns_with_field()
+    mag[20000:] += [30.0, 0.0, 0.0]
+    quat = estimate(gyr, acc, FS).quat
+    default, accepted = with_magnetometer(quat, mag, FS)
+    never, _ = with_magnetometer(quat, mag, FS, {"mag_new_time": 1e9})
+    assert np.array_equal(default, never) and accepted[20000:].mean() < 0.1
+    still = np.tile([1.0, 0.0, 0.0, 0.0], (int(200 * FS), 1))
+    field = np.tile(EARTH_FIELD_UT, (len(still), 1)).astype(float)
+    field[int(30 * FS):] = [0.0, 12.0, -38.0]
+    for params, taken in (({}, False), ({"mag_new_angle": 0.0}, True)):
+        _, accepted = with_magnetometer(still, field, FS, params)
+        assert accepted[-int(100 * FS):].all() == taken and not accepted[int(30 * FS):int(49 * FS)].any()
 
 
 def test_heading_and_tilt_start_in_motion():
