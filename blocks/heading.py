@@ -104,7 +104,7 @@ def heading_step(state, coef, q, m_sensor):
     horizontal = math.sqrt(m[0] * m[0] + m[1] * m[1])
     norm = math.sqrt(horizontal * horizontal + m[2] * m[2])
     ok = False
-    if norm > 0.0 and horizontal > 0.0:
+    if math.isfinite(norm) and horizontal > 0.0:  # else no sample (NaN: missing, all 0: none)
         dip = math.atan2(-m[2], horizontal)
         state[SEEN] += 1.0
         start = 1.0 / state[SEEN] > a_heading
@@ -131,7 +131,8 @@ def heading_step(state, coef, q, m_sensor):
 @kernel()
 def run(state, coef, quat, mag, out, accepted):
     """Per sample: out (N×4) the orientation with magnetometer heading, accepted (N) whether
-    the field passed the guard. quat N×4 (sensor → earth), mag N×3 (any unit); state
+    the field passed the guard. quat N×4 (sensor → earth), mag N×3 (any unit; a row with a
+    NaN is a missing sample, a magnetometer slower than the IMU); state
     (see initial_state) is carried over from call to call."""
     for k in range(quat.shape[0]):
         turned, ok = heading_step(state, coef, (quat[k, 0], quat[k, 1], quat[k, 2], quat[k, 3]),

@@ -36,12 +36,13 @@ def _finite_inputs(io):
 @kernel(inline=True)
 def _write_outputs(io, q, heading_state, heading_coef, heading):
     """io[10:13] holds ĝ: normalise it; q, turned to the magnetometer's heading when asked
-    and io[16:19] is finite, and its Euler angles into io[6:10], io[13:16]."""
+    (io[16:19] not finite or all 0: no new field sample), and its Euler angles into io[6:10],
+    io[13:16]."""
     norm = math.sqrt(io[10] * io[10] + io[11] * io[11] + io[12] * io[12])
     for i in range(3):
         io[10 + i] /= norm
     out = (q[0], q[1], q[2], q[3])
-    if heading and math.isfinite(io[16]) and math.isfinite(io[17]) and math.isfinite(io[18]):
+    if heading:
         out, used = heading_step(heading_state, heading_coef, out, (io[16], io[17], io[18]))
     io[6], io[7], io[8], io[9] = out
     io[13], io[14], io[15] = quat_euler_zyx(out)

@@ -32,7 +32,7 @@ class AttitudeEstimator(ProjectSlave):
         super().__init__(**kwargs)
         self.vector("gyr", (0.0, 0.0, 0.0), "rad/s", "gyro {c}, mean rate over the step", IN)
         self.vector("acc", (0.0, 0.0, 9.81), "m/s2", "specific force {c} at the end of the step", IN)
-        self.vector("mag", (0.0, 0.0, 0.0), "uT", "magnetic field {c}; all 0: no magnetometer (heading from the gyro)", IN)
+        self.vector("mag", (0.0, 0.0, 0.0), "uT", "magnetic field {c}; all 0: no magnetometer (heading from the gyro); NaN: no sample this step", IN)
         self.vector("q", (1.0, 0.0, 0.0, 0.0), "1", "orientation quaternion {c}, sensor -> earth (ENU)", OUT, "wxyz")
         self.vector("g", (0.0, 0.0, 1.0), "1", "estimated unit up-vector {c}, sensor coordinates", OUT)
         for name in ("roll", "pitch", "yaw"):

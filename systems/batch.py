@@ -67,8 +67,9 @@ def estimate(
     smoother, see blocks.accuracy.smoother_mean_square_gravity_error). gyro_offset: first
     estimate the gyro offset at rest and while moving and remove it (blocks.gyro_offset;
     offline from passes forward and backward in time; the estimate is returned as
-    `offset`). mag (N×3, µT): heading from the magnetometer with a guard
-    against disturbances (blocks.heading); without it the heading is the gyro's (6D).
+    `offset`). mag (N×3, µT; rows with a NaN are missing samples): heading from the
+    magnetometer with a guard against disturbances (blocks.heading); without it the
+    heading is the gyro's (6D).
     """
     gyr, acc = check_imu(gyr, acc, fs)
     offset = None
@@ -114,8 +115,12 @@ def _with_heading(est: AttitudeEstimate, mag, fs: float) -> AttitudeEstimate:
     if mag is None:
         return est
     mag = np.asarray(mag, dtype=float)
-    if mag.shape != est.quat[:, :3].shape or not np.isfinite(mag).all():
-        raise ValueError(f"mag must be finite with shape {est.quat[:, :3].shape}, got {mag.shape}")
+    if mag.shape != est.quat[:, :3].shape:
+        raise ValueError(f"mag must have the shape {est.quat[:, :3].shape}, got {mag.shape}")
+    if np.isinf(mag).any():
+        raise ValueError(f"mag has {int(np.isinf(mag).sum())} infinite values (NaN marks a missing sample)")
+    if np.isnan(mag).any(axis=1).all():
+        raise ValueError("mag has no sample without NaN; leave it out (heading from the gyro)")
     est.quat, est.mag_accepted = with_magnetometer(est.quat, mag, fs)
     return est
 

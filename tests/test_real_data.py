@@ -292,6 +292,17 @@ def test_a_new_field_needs_the_sensor_to_turn():
         assert accepted[-int(100 * FS):].all() == taken and not accepted[int(30 * FS):int(49 * FS)].any()
 
 
+@pytest.mark.parametrize("bad, message", [
+    (lambda m: m[:-1], "must have the shape"),
+    (lambda m: np.where(np.arange(len(m))[:, None] == 7, np.inf, m), "3 infinite values"),
+    (lambda m: np.full_like(m, np.nan), "no sample without NaN"),
+])
+def test_magnetometer_input_errors_say_what_is_wrong(bad, message):
+    gyr, acc = np.zeros((50, 3)), np.tile([0.0, 0.0, 9.81], (50, 1))
+    with pytest.raises(ValueError, match=message):
+        estimate(gyr, acc, FS, mag=bad(np.tile(EARTH_FIELD_UT, (50, 1)).astype(float)))
+
+
 def test_heading_and_tilt_start_in_motion():
     """A recording whose first samples are in vigorous motion (the first accelerometer
     sample is 28° off the vertical): the start-up means of the tilt filter and of the
