@@ -18,7 +18,9 @@ mag_new_angle is taken as proven: the estimator starts afresh from it, with the
 start-up's running means. A homogeneous field keeps its norm and dip when the
 sensor turns, a field fixed to the sensor (a magnet carried along) does not, so a wrong
 reference from a disturbed start, or a move to a place whose field differs (another
-room or building), no longer locks the magnetometer out for good.
+room or building), no longer locks the magnetometer out for good. Turning cannot tell a
+disturbance fixed in the room (a monitor beside a resting sensor) from the earth's field:
+after mag_new_time of turning there it is taken too, and left the same way.
 Inclination is untouched: the correction turns about the vertical only.
 """
 from __future__ import annotations
