@@ -44,6 +44,7 @@ PARAMS = (
 )
 REF_NORM, REF_DIP, SEEN = 1, 2, 3
 CAND_NORM, CAND_DIP, CAND_N, CAND_DOT, CAND_Q0 = 4, 5, 6, 7, 8  # q₀ in 8…11
+STEPS, CAND_START, GAP = 12, 13, 14
 
 
 def resolve(overrides=None) -> dict:
@@ -51,18 +52,19 @@ def resolve(overrides=None) -> dict:
 
 
 def coefficients(params, Ts: float) -> np.ndarray:
-    """[a_heading, a_reference, mag_norm_tol, mag_dip_tol, heading_clip, samples a new
-    field must stay steady, cos(mag_new_angle/2)]; a_* = 1 − exp(−Ts/τ)."""
-    return np.array([1.0 - math.exp(-Ts / params["tau_heading"]), 1.0 - math.exp(-Ts / params["tau_reference"]),
+    """[Ts/tau_heading, Ts/tau_reference, mag_norm_tol, mag_dip_tol, heading_clip, steps a
+    new field must stay steady, cos(mag_new_angle/2)]. Ts is the step (IMU sample) time."""
+    return np.array([Ts / params["tau_heading"], Ts / params["tau_reference"],
                      params["mag_norm_tol"], params["mag_dip_tol"], params["heading_clip"],
                      params["mag_new_time"] / Ts, math.cos(0.5 * params["mag_new_angle"])])
 
 
 def initial_state() -> np.ndarray:
-    """[ψ_c (rad), reference norm, reference dip (rad), samples seen with a field,
-    candidate norm, candidate dip (rad), samples in the candidate, smallest |q·q₀| since
-    the candidate began, q₀ (4, the orientation then)]."""
-    state = np.zeros(12)
+    """[ψ_c (rad), reference norm, reference dip (rad), field samples since the start-up
+    began, candidate norm, candidate dip (rad), field samples in the candidate, smallest
+    |q·q₀| since the candidate began, q₀ (4, the orientation then), steps since the
+    start-up began, the step the candidate began at, steps since the last field sample]."""
+    state = np.zeros(15)
     state[CAND_DOT] = 1.0
     return state
 
@@ -77,7 +79,7 @@ def _new_reference(state, coef, q, norm, dip):
     """A sample outside the reference's tolerance: extend the candidate field (or begin one
     at this sample); True when the candidate has stayed steady for mag_new_time while the
     sensor turned through mag_new_angle: the heading estimator then starts afresh."""
-    norm_tol, dip_tol, samples, cos_half = coef[2], coef[3], coef[5], coef[6]
+    norm_tol, dip_tol, steps, cos_half = coef[2], coef[3], coef[5], coef[6]
     if state[CAND_N] > 0.0 and _steady(norm, dip, state[CAND_NORM], state[CAND_DIP], norm_tol, dip_tol):
         state[CAND_N] += 1.0
         state[CAND_NORM] += (norm - state[CAND_NORM]) / state[CAND_N]
@@ -86,11 +88,12 @@ def _new_reference(state, coef, q, norm, dip):
         for i in range(4):
             dot += q[i] * state[CAND_Q0 + i]
         state[CAND_DOT] = min(state[CAND_DOT], abs(dot))
-        if state[CAND_N] >= samples and state[CAND_DOT] <= cos_half:
+        if state[STEPS] - state[CAND_START] + 1.0 >= steps and state[CAND_DOT] <= cos_half:
             state[CAND_N] = 0.0
             return True
         return False
     state[CAND_NORM], state[CAND_DIP], state[CAND_N], state[CAND_DOT] = norm, dip, 1.0, 1.0
+    state[CAND_START] = state[STEPS]
     for i in range(4):
         state[CAND_Q0 + i] = q[i]
     return False
@@ -98,9 +101,14 @@ def _new_reference(state, coef, q, norm, dip):
 
 @kernel(inline=True)
 def heading_step(state, coef, q, m_sensor):
-    """One sample: (q turned by the updated ψ_c, whether the field was used). q is the
-    attitude filter's orientation (4-tuple), m_sensor the field (3-tuple); state in place."""
-    a_heading, a_reference, norm_tol, dip_tol, clip = coef[0], coef[1], coef[2], coef[3], coef[4]
+    """One step: (q turned by the updated ψ_c, whether the field was used). q is the
+    attitude filter's orientation (4-tuple), m_sensor the field (3-tuple; a NaN: no field
+    sample this step, a slower magnetometer); state in place. Times count steps, so a
+    slower magnetometer keeps the time constants in seconds."""
+    clip = coef[4]
+    state[GAP] += 1.0
+    if state[SEEN] > 0.0:
+        state[STEPS] += 1.0
     half = 0.5 * state[0]
     m = quat_rotate(quat_multiply((math.cos(half), 0.0, 0.0, math.sin(half)), q), m_sensor)
     horizontal = math.sqrt(m[0] * m[0] + m[1] * m[1])
@@ -108,21 +116,25 @@ def heading_step(state, coef, q, m_sensor):
     ok = False
     if math.isfinite(norm) and horizontal > 0.0:  # else no sample (NaN: missing, all 0: none)
         dip = math.atan2(-m[2], horizontal)
+        gap, state[GAP] = state[GAP], 0.0
+        if state[SEEN] == 0.0:
+            state[STEPS] = 1.0
         state[SEEN] += 1.0
-        start = 1.0 / state[SEEN] > a_heading
+        start = 1.0 / state[STEPS] > 1.0 - math.exp(-coef[0])  # within tau_heading of the start
         if not start:
-            ok = _steady(norm, dip, state[REF_NORM], state[REF_DIP], norm_tol, dip_tol)
+            ok = _steady(norm, dip, state[REF_NORM], state[REF_DIP], coef[2], coef[3])
             if ok:
                 state[CAND_N] = 0.0
             elif _new_reference(state, coef, q, norm, dip):
-                state[SEEN], start = 1.0, True  # a proven field: start afresh from it
+                state[SEEN], state[STEPS], start = 1.0, 1.0, True  # a proven field: start afresh
         if start:  # running means, every sample
             ok = True
             state[0] += math.atan2(m[0], m[1]) / state[SEEN]
             state[REF_NORM] += (norm - state[REF_NORM]) / state[SEEN]
             state[REF_DIP] += (dip - state[REF_DIP]) / state[SEEN]
-        elif ok:
-            state[0] += a_heading * min(clip, max(-clip, math.atan2(m[0], m[1])))
+        elif ok:  # first-order pulls over the time since the last field sample
+            state[0] += (1.0 - math.exp(-gap * coef[0])) * min(clip, max(-clip, math.atan2(m[0], m[1])))
+            a_reference = 1.0 - math.exp(-gap * coef[1])
             state[REF_NORM] += a_reference * (norm - state[REF_NORM])
             state[REF_DIP] += a_reference * (dip - state[REF_DIP])
     state[0] = math.atan2(math.sin(state[0]), math.cos(state[0]))
