@@ -120,7 +120,7 @@ def _with_heading(est: AttitudeEstimate, mag, fs: float) -> AttitudeEstimate:
     if np.isinf(mag).any():
         raise ValueError(f"mag has {int(np.isinf(mag).sum())} infinite values (NaN marks a missing sample)")
     if np.isnan(mag).any(axis=1).all():
-        raise ValueError("mag has no sample without NaN; leave it out (heading from the gyro)")
+        raise ValueError("mag has no sample without NaN: estimate without it (--heading gyro, or mag=None)")
     est.quat, est.mag_accepted = with_magnetometer(est.quat, mag, fs)
     return est
 
