@@ -53,10 +53,12 @@ def resolve(overrides=None) -> dict:
 
 def coefficients(params, Ts: float) -> np.ndarray:
     """[Ts/tau_heading, Ts/tau_reference, mag_norm_tol, mag_dip_tol, heading_clip, steps a
-    new field must stay steady, cos(mag_new_angle/2)]. Ts is the step (IMU sample) time."""
+    new field must stay steady, cos(mag_new_angle/2), 1 − exp(−Ts/tau_heading)]. Ts is the
+    step (IMU sample) time."""
     return np.array([Ts / params["tau_heading"], Ts / params["tau_reference"],
                      params["mag_norm_tol"], params["mag_dip_tol"], params["heading_clip"],
-                     params["mag_new_time"] / Ts, math.cos(0.5 * params["mag_new_angle"])])
+                     params["mag_new_time"] / Ts, math.cos(0.5 * params["mag_new_angle"]),
+                     1.0 - math.exp(-Ts / params["tau_heading"])])
 
 
 def initial_state() -> np.ndarray:
@@ -120,7 +122,7 @@ def heading_step(state, coef, q, m_sensor):
         if state[SEEN] == 0.0:
             state[STEPS] = 1.0
         state[SEEN] += 1.0
-        start = 1.0 / state[STEPS] > 1.0 - math.exp(-coef[0])  # within tau_heading of the start
+        start = 1.0 / state[STEPS] > coef[7]  # within tau_heading of the start
         if not start:
             ok = _steady(norm, dip, state[REF_NORM], state[REF_DIP], coef[2], coef[3])
             if ok:

@@ -117,8 +117,9 @@ def _with_heading(est: AttitudeEstimate, mag, fs: float) -> AttitudeEstimate:
     mag = np.asarray(mag, dtype=float)
     if mag.shape != est.quat[:, :3].shape:
         raise ValueError(f"mag must have the shape {est.quat[:, :3].shape}, got {mag.shape}")
-    if np.isinf(mag).any():
-        raise ValueError(f"mag has {int(np.isinf(mag).sum())} infinite values (NaN marks a missing sample)")
+    infinite = int(np.isinf(mag).sum())
+    if infinite:
+        raise ValueError(f"mag has {infinite} infinite values (NaN marks a missing sample)")
     if np.isnan(mag).any(axis=1).all():
         raise ValueError("mag has no sample without NaN: estimate without it (--heading gyro, or mag=None)")
     est.quat, est.mag_accepted = with_magnetometer(est.quat, mag, fs)
