@@ -2,8 +2,11 @@
 
 At rest: the gyro and the accelerometer, each low-passed (time constant tau_lp), must stay
 close to their low-passed values (rest_gyr, rest_acc) and the low-passed gyro must stay
-small (rest_gyr_abs) for rest_time seconds; then the offset estimate follows the
-low-passed gyro with time constant tau_bias.
+small (rest_gyr_abs) for rest_time seconds; then each gyro sample measures the offset
+with the variance of the gyro's white noise, delta_n²·fs/2, in the same Kalman filter as
+the tracking while moving: a first rest after an uncertain start gives the running mean
+of the rest's samples, and a long rest settles on a window of delta_n/sigma_motion·
+√(tau_motion/2) s (7 s by default), whatever the sample rate.
 
 While moving, the offset's effect on the accelerometer is tracked in the gyro frame (the
 frame integrated from the corrected gyro; R its sensor → gyro-frame rotation), the way
@@ -19,9 +22,8 @@ c. Guards, all from the same model:
   alone, since a sensor-fixed (e.g. centripetal) acceleration looks the same there;
 - innovations are clipped at 4·sigma_init, the fastest turn a plausible offset makes;
 - no update in the first 3·tau_acc, while the low-pass forgets its first sample.
-A rest phase replaces the estimate by the rest average and its variance shrinks with
-the old estimate's weight. The corrected gyro is the measured one minus the estimate
-after its sample. Causal, one compiled step per sample.
+The corrected gyro is the measured one minus the estimate after its sample. Causal, one
+compiled step per sample.
 """
 from __future__ import annotations
 
@@ -41,7 +43,7 @@ PARAMS = (
     Param("rest_acc", 0.5, "m/s²", "largest deviation of the accelerometer from its low-pass at rest"),
     Param("rest_time", 1.5, "s", "time the rest conditions must hold"),
     Param("tau_lp", 0.5, "s", "time constant of the low-passes of the rest detection"),
-    Param("tau_bias", 10.0, "s", "time constant of the offset estimate's averaging at rest"),
+    Param("delta_n", math.radians(0.1), "rad/s/√Hz", "gyro noise density, one-sided (datasheet): each sample's weight at rest"),
     Param("tau_acc", 3.0, "s", "time constant of the accelerometer low-pass in the gyro frame (motion tracking)"),
     Param("sigma_init", math.radians(0.5), "rad/s", "uncertainty of the offset before any rest (per axis)"),
     Param("sigma_motion", math.radians(0.1), "rad/s", "uncertainty the tracking while moving settles on (per axis)"),
@@ -69,14 +71,15 @@ def resolve(overrides=None) -> dict:
 
 
 def coefficients(params, Ts: float) -> np.ndarray:
-    """[Ts, a_lp, a_bias, rest_gyr, rest_gyr_abs, rest_acc, rest_time, ω_acc·Ts, P0, V, W]:
-    a_* = 1 − exp(−Ts/τ), ω_acc = √2/τ_acc (rad/s); the Kalman update while moving has the
-    initial variance P0 = σ_init², the process noise V = σ_motion²·Ts/τ_motion per sample
-    and the measurement noise W = σ_motion⁴/V + σ_motion², with which its variance settles
-    on σ_motion² (V = 0: no tracking while moving)."""
+    """[Ts, a_lp, r, rest_gyr, rest_gyr_abs, rest_acc, rest_time, ω_acc·Ts, P0, V, W]:
+    a_lp = 1 − exp(−Ts/τ_lp), r = δn²/(2·Ts) the variance of a gyro sample's white noise
+    ((rad/s)²), ω_acc = √2/τ_acc (rad/s); the Kalman filter has the initial variance
+    P0 = σ_init², the process noise V = σ_motion²·Ts/τ_motion per sample and, while moving,
+    the measurement noise W = σ_motion⁴/V + σ_motion², with which its variance settles on
+    σ_motion² (V = 0: no tracking while moving)."""
     tau_motion, s2 = params["tau_motion"], params["sigma_motion"] ** 2
     V = s2 * Ts / tau_motion if tau_motion > 0 else 0.0
-    return np.array([Ts, 1.0 - math.exp(-Ts / params["tau_lp"]), 1.0 - math.exp(-Ts / params["tau_bias"]),
+    return np.array([Ts, 1.0 - math.exp(-Ts / params["tau_lp"]), params["delta_n"] ** 2 / (2.0 * Ts),
                      params["rest_gyr"], params["rest_gyr_abs"], params["rest_acc"], params["rest_time"],
                      math.sqrt(2.0) / params["tau_acc"] * Ts, params["sigma_init"] ** 2, V,
                      s2 * s2 / V + s2 if V > 0 else 0.0])
@@ -140,7 +143,7 @@ def motion_update(b, P, old, new, r_lp, rb_lp, Ts, W, clip):
 def run(state, coef, gyr, acc, offset, variance):
     """Over N samples: the offset estimate after each sample (N×3, rad/s) and its variance
     per axis (N×3, (rad/s)²)."""
-    Ts, a_lp, a_bias, rest_gyr, rest_gyr_abs, rest_acc, rest_time, wt, P0, V, W = (
+    Ts, a_lp, r, rest_gyr, rest_gyr_abs, rest_acc, rest_time, wt, P0, V, W = (
         coef[0], coef[1], coef[2], coef[3], coef[4], coef[5], coef[6], coef[7], coef[8], coef[9], coef[10])
     settle = SETTLE_TAUS * math.sqrt(2.0) * Ts / wt
     clip = CLIP_SIGMAS * math.sqrt(P0)
@@ -182,10 +185,10 @@ def run(state, coef, gyr, acc, offset, variance):
                     lowpass_step(r_lp, 3 * i + j, col[i], Ad, Bd)
         for i in range(3):
             P[i, i] = min(P[i, i] + V, P0)
-        if state[6] >= rest_time:
-            for i in range(3):
-                b[i] += a_bias * (state[i] - b[i])
-            P *= (1.0 - a_bias) ** 2
+        if state[6] >= rest_time:  # the gyro sample measures b with variance r
+            K = P @ np.linalg.inv(P + r * np.eye(3))
+            b += K @ (gyr[k] - b)
+            P -= K @ P
         elif V > 0.0 and state[T] > settle:
             motion_update(b, P, old, acc_lp[0], r_lp[0], rb_lp[0], Ts, W, clip)
         for i in range(3):

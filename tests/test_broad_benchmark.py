@@ -5,6 +5,7 @@ import math
 import os
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from systems.batch import estimate
@@ -56,3 +57,14 @@ def test_vqf_figures_are_the_wiener_filter_at_its_break_frequency(table):
         est = estimate(rec.gyr, rec.acc, rec.fs, "wiener", {"omega_g": math.sqrt(2) / VQF_TAU_ACC}, gyro_offset=True)
         ours = errors_on_movement(est.quat, rec)["inclination_rmse_deg"]
         assert ours == pytest.approx(table["recordings"][rec.name]["vqf"]["inclination_rmse_deg"], abs=0.05), rec.name
+
+
+def test_a_constant_gyro_offset_added_to_the_recordings_changes_nothing():
+    """Every recording begins at rest: the rest's gyro samples give the offset (their Kalman
+    mean, blocks.gyro_offset), so 1.4 °/s more offset leaves the inclination as it was."""
+    added = np.radians([1.0, -0.5, 0.8])
+    for path in FILES:
+        rec = read_recording(path)
+        rmse = [errors_on_movement(estimate(gyr, rec.acc, rec.fs, gyro_offset=True).quat, rec)["inclination_rmse_deg"]
+                for gyr in (rec.gyr, rec.gyr + added)]
+        assert rmse[1] == pytest.approx(rmse[0], abs=0.005), rec.name

@@ -94,6 +94,27 @@ def test_gyro_offset_converges_and_attitude_stays_bounded_over_an_hour():
     assert without[after_first_rest:].max() > 4 * inclination[after_first_rest:].max()
 
 
+def test_a_short_rest_gives_the_mean_of_its_gyro_samples():
+    """A 2 °/s offset and 10 s at rest: once rest is detected (1.5 s) each gyro sample
+    counts with the white-noise variance r = δn²·fs/2 of the default δn = 0.1 °/s/√Hz, so
+    the estimate is the Kalman mean of a constant: the rest's n samples against the prior
+    (0, σ_init² = (0.5 °/s)²), Σg/(n + r/σ_init²), not an average still forgetting its start
+    (the offset's allowed drift, σ_motion per τ_motion, weights late samples a little more)."""
+    rng = np.random.default_rng(7)
+    n = int(10 * FS)
+    offset = np.radians([2.0, -1.0, 1.5])
+    gyr = offset + rng.normal(0.0, math.radians(0.03) * math.sqrt(FS / 2), (n, 3))
+    acc = np.array([0.0, 0.0, 9.81]) + rng.normal(0.0, 0.02, (n, 3))
+    _, estimate_ = correct_gyro(gyr, acc, FS)
+    rest_from = int(np.argmax(np.abs(estimate_).sum(axis=1) > 0))
+    assert abs(rest_from - 1.5 * FS) <= 1  # the rest conditions hold from the first sample on
+    prior_weight = (math.radians(0.1) ** 2 * FS / 2) / math.radians(0.5) ** 2
+    for k in (int(3 * FS), n - 1):
+        mean = gyr[rest_from:k + 1].sum(axis=0) / (k + 1 - rest_from + prior_weight)
+        assert np.degrees(np.abs(estimate_[k] - mean)).max() < 0.005  # °/s
+    assert np.degrees(np.abs(estimate_[-1] - offset)).max() < 0.03  # 4 σ of 850 samples' mean
+
+
 @pytest.mark.parametrize("size", [1.0, 3.0])  # °/s; vqf clips its estimate at 2 °/s
 def test_offset_is_tracked_while_moving_without_rest(size):
     """No rest at all: the accelerometer in the gyro frame pins the offset down (blocks.gyro_offset)."""
