@@ -6,7 +6,11 @@ small (rest_gyr_abs) for rest_time seconds; then each gyro sample measures the o
 with the variance of the gyro's white noise, delta_n²·fs/2, in the same Kalman filter as
 the tracking while moving: a first rest after an uncertain start gives the running mean
 of the rest's samples, and a long rest settles on a window of delta_n/sigma_motion·
-√(tau_motion/2) s (7 s by default), whatever the sample rate.
+√(tau_motion/2) s (7 s by default), whatever the sample rate. The deviations are tested
+sample by sample, as vqf does: a gyro whose white noise alone comes near rest_gyr
+(δn·√(3·fs/2), e.g. 0.1 °/s/√Hz at 250 Hz) seldom or never rests, and its offset then
+comes from the tracking while moving, which cannot see the component along gravity.
+(Testing mean squares instead, with the noise allowed for, took slow motion for rest.)
 
 While moving, the offset's effect on the accelerometer is tracked in the gyro frame (the
 frame integrated from the corrected gyro; R its sensor → gyro-frame rotation), the way
