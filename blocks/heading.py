@@ -21,6 +21,8 @@ reference from a disturbed start, or a move to a place whose field differs (anot
 room or building), no longer locks the magnetometer out for good. Turning cannot tell a
 disturbance fixed in the room (a monitor beside a resting sensor) from the earth's field:
 after mag_new_time of turning there it is taken too, and left the same way.
+Before all this the field is freed of a hard-iron offset, a field fixed to the sensor,
+when a sphere fit proves one (blocks.hard_iron; its parameters are listed here too).
 Inclination is untouched: the correction turns about the vertical only.
 """
 from __future__ import annotations
@@ -29,6 +31,8 @@ import math
 
 import numpy as np
 
+from . import hard_iron
+from .hard_iron import hard_iron_step
 from .jit import kernel
 from .methods import Param, resolve_params
 from .quaternion import quat_multiply, quat_rotate
@@ -41,10 +45,12 @@ PARAMS = (
     Param("heading_clip", math.radians(10.0), "rad", "largest heading innovation one sample may use"),
     Param("mag_new_time", 20.0, "s", "how long a field outside the reference's tolerance must stay steady to replace it"),
     Param("mag_new_angle", math.radians(90.0), "rad", "how far the sensor must turn meanwhile (0: no turn)", True),
-)
+) + hard_iron.PARAMS
 REF_NORM, REF_DIP, SEEN = 1, 2, 3
 CAND_NORM, CAND_DIP, CAND_N, CAND_DOT, CAND_Q0 = 4, 5, 6, 7, 8  # q₀ in 8…11
 STEPS, CAND_START, GAP = 12, 13, 14
+HARD_IRON = slice(15, 15 + hard_iron.STATE_SIZE)  # blocks.hard_iron's state
+HARD_IRON_OFFSET = HARD_IRON.start + hard_iron.OFFSET.start  # its offset estimate in 3 entries from here
 
 
 def resolve(overrides=None) -> dict:
@@ -53,20 +59,22 @@ def resolve(overrides=None) -> dict:
 
 def coefficients(params, Ts: float) -> np.ndarray:
     """[Ts/tau_heading, Ts/tau_reference, mag_norm_tol, mag_dip_tol, heading_clip, steps a
-    new field must stay steady, cos(mag_new_angle/2), 1 − exp(−Ts/tau_heading)]. Ts is the
-    step (IMU sample) time."""
-    return np.array([Ts / params["tau_heading"], Ts / params["tau_reference"],
-                     params["mag_norm_tol"], params["mag_dip_tol"], params["heading_clip"],
-                     params["mag_new_time"] / Ts, math.cos(0.5 * params["mag_new_angle"]),
-                     1.0 - math.exp(-Ts / params["tau_heading"])])
+    new field must stay steady, cos(mag_new_angle/2), 1 − exp(−Ts/tau_heading), then
+    blocks.hard_iron's coefficients]. Ts is the step (IMU sample) time."""
+    return np.concatenate([[Ts / params["tau_heading"], Ts / params["tau_reference"],
+                            params["mag_norm_tol"], params["mag_dip_tol"], params["heading_clip"],
+                            params["mag_new_time"] / Ts, math.cos(0.5 * params["mag_new_angle"]),
+                            1.0 - math.exp(-Ts / params["tau_heading"])],
+                           hard_iron.coefficients(params, Ts)])
 
 
 def initial_state() -> np.ndarray:
     """[ψ_c (rad), reference norm, reference dip (rad), field samples since the start-up
     began, candidate norm, candidate dip (rad), field samples in the candidate, smallest
     |q·q₀| since the candidate began, q₀ (4, the orientation then), steps since the
-    start-up began, the step the candidate began at, steps since the last field sample]."""
-    state = np.zeros(15)
+    start-up began, the step the candidate began at, steps since the last field sample,
+    then blocks.hard_iron's state]."""
+    state = np.zeros(HARD_IRON.stop)
     state[CAND_DOT] = 1.0
     return state
 
@@ -111,6 +119,11 @@ def heading_step(state, coef, q, m_sensor):
     state[GAP] += 1.0
     if state[SEEN] > 0.0:
         state[STEPS] += 1.0
+    n2 = m_sensor[0] * m_sensor[0] + m_sensor[1] * m_sensor[1] + m_sensor[2] * m_sensor[2]
+    if math.isfinite(n2) and n2 > 0.0:  # a field sample (not NaN: missing, not all 0: none)
+        m_sensor, proven = hard_iron_step(state[HARD_IRON], coef[8:11], m_sensor, state[GAP], coef[2], coef[5])
+        if proven:  # a field freed of (or back without) an offset: start afresh from it
+            state[SEEN] = 0.0
     half = 0.5 * state[0]
     m = quat_rotate(quat_multiply((math.cos(half), 0.0, 0.0, math.sin(half)), q), m_sensor)
     horizontal = math.sqrt(m[0] * m[0] + m[1] * m[1])
@@ -145,22 +158,26 @@ def heading_step(state, coef, q, m_sensor):
 
 
 @kernel()
-def run(state, coef, quat, mag, out, accepted):
+def run(state, coef, quat, mag, out, accepted, offset):
     """Per sample: out (N×4) the orientation with magnetometer heading, accepted (N) whether
-    the field passed the guard. quat N×4 (sensor → earth), mag N×3 (any unit; a row with a
-    NaN is a missing sample, a magnetometer slower than the IMU); state
-    (see initial_state) is carried over from call to call."""
+    the field passed the guard, offset (N×3) the hard-iron estimate. quat N×4 (sensor →
+    earth), mag N×3 (µT; a row with a NaN is a missing sample, a magnetometer slower than
+    the IMU); state (see initial_state) is carried over from call to call."""
     for k in range(quat.shape[0]):
         turned, ok = heading_step(state, coef, (quat[k, 0], quat[k, 1], quat[k, 2], quat[k, 3]),
                                   (mag[k, 0], mag[k, 1], mag[k, 2]))
         out[k, 0], out[k, 1], out[k, 2], out[k, 3] = turned
         accepted[k] = ok
+        for i in range(3):
+            offset[k, i] = state[HARD_IRON_OFFSET + i]
 
 
 def with_magnetometer(quat, mag, fs: float, params=None):
-    """(orientation with magnetometer heading N×4, accepted N) for a whole recording."""
+    """(orientation with magnetometer heading N×4, accepted N, hard-iron offset N×3 in the
+    field's unit) for a whole recording."""
     out = np.empty_like(quat)
     accepted = np.empty(len(quat), dtype=np.bool_)
+    offset = np.empty((len(quat), 3))
     run(initial_state(), coefficients(resolve(params), 1.0 / fs), np.ascontiguousarray(quat),
-        np.ascontiguousarray(mag, dtype=float), out, accepted)
-    return out, accepted
+        np.ascontiguousarray(mag, dtype=float), out, accepted, offset)
+    return out, accepted, offset

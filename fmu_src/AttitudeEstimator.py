@@ -39,7 +39,7 @@ class AttitudeEstimator(ProjectSlave):
             self.real(name, 0.0, "rad", f"{name} (Z-Y-X Euler angles of q; derived output)", OUT)
         self.boolean_output("valid", False, "an estimate is available and the last inputs were finite")
         self.parameter("method", "wiener", f"estimator: {', '.join(METHODS)}")
-        self.parameter("heading", "mag", "heading source: mag (magnetometer, guarded against disturbances) or gyro")
+        self.parameter("heading", "mag", "heading source: mag (magnetometer, hard iron fitted, guarded against disturbances) or gyro")
         self.parameter("gyro_offset", "off", "on: estimate and remove the gyro offset (at rest and while moving); off")
         self.real("Ts", 0.01, "s", "sample time the estimator expects (other step sizes are re-discretised)", PAR)
         for name, (unit, doc) in tuning_parameters().items():

@@ -27,6 +27,7 @@ class AttitudeEstimate:
     quat: np.ndarray
     offset: np.ndarray | None = None  # N×3 gyro-offset estimate, rad/s, when one was made
     mag_accepted: np.ndarray | None = None  # N, magnetometer samples the heading used
+    mag_offset: np.ndarray | None = None  # N×3, µT, hard-iron offset estimate (blocks.hard_iron)
 
     @property
     def up(self) -> np.ndarray:
@@ -122,7 +123,7 @@ def _with_heading(est: AttitudeEstimate, mag, fs: float) -> AttitudeEstimate:
         raise ValueError(f"mag has {infinite} infinite values (NaN marks a missing sample)")
     if np.isnan(mag).any(axis=1).all():
         raise ValueError("mag has no sample without NaN: estimate without it (--heading gyro, or mag=None)")
-    est.quat, est.mag_accepted = with_magnetometer(est.quat, mag, fs)
+    est.quat, est.mag_accepted, est.mag_offset = with_magnetometer(est.quat, mag, fs)
     return est
 
 

@@ -300,21 +300,69 @@ def test_heading_takes_a_new_field_that_stays_steady_while_the_sensor_turns(case
 
 def test_a_new_field_needs_the_sensor_to_turn():
     """A field fixed to the sensor (a magnet carried along, 30 µT for the last 400 s of the
-    turning) changes its norm and dip as the sensor turns: never taken as the reference,
-    the output equals that of an estimator that never takes one. A steady new field at a
-    sensor that does not turn is refused as well, until mag_new_angle asks for no turn."""
+    turning) changes its norm and dip as the sensor turns: never taken as the reference
+    (the hard-iron fit, which would remove it, off), the output equals that of an
+    estimator that never takes one. A steady new field at a sensor that does not turn is
+    refused as well, until mag_new_angle asks for no turn."""
     motion, gyr, acc, mag = _turns_with_field()
     mag[20000:] += [30.0, 0.0, 0.0]
     quat = estimate(gyr, acc, FS).quat
-    default, accepted = with_magnetometer(quat, mag, FS)
-    never, _ = with_magnetometer(quat, mag, FS, {"mag_new_time": 1e9})
+    default, accepted, _ = with_magnetometer(quat, mag, FS, {"mag_cal_time": 0.0})
+    never, _, _ = with_magnetometer(quat, mag, FS, {"mag_new_time": 1e9, "mag_cal_time": 0.0})
     assert np.array_equal(default, never) and accepted[20000:].mean() < 0.1
     still = np.tile([1.0, 0.0, 0.0, 0.0], (int(200 * FS), 1))
     field = np.tile(EARTH_FIELD_UT, (len(still), 1)).astype(float)
     field[int(30 * FS):] = [0.0, 12.0, -38.0]
     for params, taken in (({}, False), ({"mag_new_angle": 0.0}, True)):
-        _, accepted = with_magnetometer(still, field, FS, params)
+        _, accepted, _ = with_magnetometer(still, field, FS, params)
         assert accepted[-int(100 * FS):].all() == taken and not accepted[int(30 * FS):int(49 * FS)].any()
+
+
+@pytest.mark.parametrize("offset, start", [((5.0, 0.0, 0.0), 0), ((40.0, 10.0, -20.0), 0), ((30.0, 0.0, 0.0), 200)])
+def test_a_hard_iron_offset_is_fitted_and_removed(offset, start):
+    """A field fixed to the sensor from `start` s on (the magnetometer's own hard iron, or a
+    magnet carried along): once the sphere fit of the recent samples proves it (samples in
+    every direction, a sphere about b and not about 0, for mag_new_time), it is removed and
+    the heading follows the earth's field; with the fit off the guard can only fall back
+    on the gyro. On the clean field the estimate stays exactly 0."""
+    motion, gyr, acc, mag = _turns_with_field()
+    quat = estimate(gyr, acc, FS, gyro_offset=True).quat  # 6D
+    _, _, clean_offset = with_magnetometer(quat, mag, FS)
+    assert not clean_offset.any()
+    mag[int(start * FS):] += offset
+    heading_of = lambda out: np.degrees(quaternion_errors(out, motion.quat)[1])
+    out, _, estimate_ = with_magnetometer(quat, mag, FS)
+    without = heading_of(with_magnetometer(quat, mag, FS, {"mag_cal_time": 0.0})[0])
+    taken = int(np.argmax(np.abs(estimate_).sum(axis=1) > 0))
+    heading = heading_of(out)
+    print(f"hard iron {offset} µT from {start} s: taken at {taken / FS:.0f} s, estimate "
+          f"{np.round(estimate_[-1], 2)}, heading max from 5 s later {heading[taken + int(5 * FS):].max():.2f}°, "
+          f"without the fit {without[taken:].max():.2f}°")
+    assert start * FS < taken < (start + 250) * FS
+    assert np.abs(estimate_[-1] - offset).max() < 0.5  # µT
+    assert heading[taken + int(5 * FS):].max() < 2.0
+    assert without[taken:].max() > 5.0
+
+
+def _hard_iron_case():
+    """150 s of the turning's true orientation and field, with 18 µT of hard iron (taken at
+    75 s) and every third field sample missing: every branch of blocks.hard_iron."""
+    motion, _, _, mag = _turns_with_field()
+    n = int(150 * FS)
+    mag = mag[:n] + [15.0, -5.0, 8.0]
+    mag[1::3] = np.nan
+    return np.ascontiguousarray(motion.quat[:n]), mag
+
+
+def test_heading_compiled_equals_its_plain_python_source():
+    code = ("import json; from blocks.heading import with_magnetometer; "
+            "from tests.test_real_data import _hard_iron_case;"
+            "out, _, offset = with_magnetometer(*_hard_iron_case(), 100.0);"
+            "print(json.dumps([out.tolist(), offset.tolist()]))")
+    out, _, offset = with_magnetometer(*_hard_iron_case(), FS)
+    assert offset[-1].any()
+    plain_out, plain_offset = (np.array(x) for x in interpreted_json(code))
+    assert np.abs(plain_out - out).max() <= 1e-9 and np.abs(plain_offset - offset).max() <= 1e-9
 
 
 @pytest.mark.parametrize("bad, message", [

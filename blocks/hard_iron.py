@@ -1,0 +1,120 @@
+"""Hard-iron offset of the magnetometer: a field fixed to the sensor (its own magnetised
+parts, a magnet carried along), estimated so that the heading stage sees the earth's field.
+
+A homogeneous field h seen by a sensor that turns lies on a sphere: |m − b| = r. Over
+the recent samples (sums forgotten in mag_cal_time) the algebraic sphere fit
+|m|² = 2·m·b + c, c = r² − |b|², is a linear least-squares problem in (b, c), solved
+from running sums each field sample. Its residual, as a distance from the sphere, is
+set against that of the field as it is (b = 0: the spread of |m|). The offset is used
+only when the fit explains the field and the field as it is does not, for as long as a
+new reference field must stay steady (blocks.heading's mag_new_time):
+- the samples cover every direction: the field's s.d. across its smallest axis is at
+  least mag_cal_spread of the radius (a sensor turning about one axis draws a circle,
+  which leaves b along that axis open);
+- the fit's rms distance from the sphere is below mag_cal_tol of its radius and below
+  half that of the field as it is;
+- the offset is larger than the guard's norm tolerance (mag_norm_tol of the radius):
+  smaller ones are the guard's business, and a calibrated magnetometer in a lab whose
+  field is not quite homogeneous is left alone.
+Then b follows the fit; it is reset to 0 once the field as it is stays within
+mag_cal_tol of a sphere about 0 for the same time, and kept otherwise (a disturbance
+passing by does not undo a calibration). When b is taken or dropped, the field it leaves
+is proven homogeneous, and the heading stage starts afresh from it. Soft iron (a scaled, skewed sphere) is not
+modelled. mag_cal_time = 0 switches the estimate off.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .jit import kernel
+from .methods import Param
+
+PARAMS = (
+    Param("mag_cal_time", 60.0, "s", "time over which the hard-iron fit forgets its samples (0: no hard-iron estimate)",
+          True),
+    Param("mag_cal_spread", 0.1, "1", "least s.d. of the field across its smallest axis, relative to the fit's radius"),
+    Param("mag_cal_tol", 0.05, "1", "largest rms distance of the field from the fitted sphere, relative to its radius"),
+)
+EXPLAINED = 0.5  # the fit's residual must be below this share of the field's own
+SUMS, OFFSET, FIT_STEPS, RAW_STEPS = slice(0, 15), slice(15, 18), 18, 19
+STATE_SIZE = 20  # Σ1, Σm (3), Σm·mᵀ (xx xy xz yy yz zz), Σm·|m|² (3), Σ|m|², Σ|m|⁴; b (3); steady steps of each model
+
+
+def coefficients(params, Ts: float) -> np.ndarray:
+    """[mag_cal_time/Ts (steps; 0: off), mag_cal_spread, mag_cal_tol]."""
+    return np.array([params["mag_cal_time"] / Ts, params["mag_cal_spread"], params["mag_cal_tol"]])
+
+
+@kernel(inline=True)
+def _accumulate(s, m, forget):
+    """The running sums s (see STATE_SIZE) after the field sample m, the old sums scaled by forget."""
+    n2 = m[0] * m[0] + m[1] * m[1] + m[2] * m[2]
+    terms = (1.0, m[0], m[1], m[2], m[0] * m[0], m[0] * m[1], m[0] * m[2], m[1] * m[1], m[1] * m[2],
+             m[2] * m[2], m[0] * n2, m[1] * n2, m[2] * n2, n2, n2 * n2)
+    for i in range(15):
+        s[i] = forget * s[i] + terms[i]
+
+
+@kernel(inline=True)
+def _fit(s):
+    """(b (3), radius, rms distance from the fitted sphere, the same for the sphere about 0,
+    s.d. of the field across its smallest axis), all in the field's unit; radius 0: no fit."""
+    w = 1.0 / s[0]
+    mu = np.array([s[1], s[2], s[3]]) * w
+    second = np.array([[s[4], s[5], s[6]], [s[5], s[7], s[8]], [s[6], s[8], s[9]]]) * w
+    n2, n4 = s[13] * w, s[14] * w
+    raw_radius = math.sqrt(n2)
+    raw_distance = math.sqrt(max(n4 - n2 * n2, 0.0)) / (2.0 * raw_radius)
+    spread = math.sqrt(max(np.linalg.eigvalsh(second - np.outer(mu, mu))[0], 0.0))
+    M = np.empty((4, 4))
+    M[0:3, 0:3] = 4.0 * second
+    M[0:3, 3] = 2.0 * mu
+    M[3, 0:3] = 2.0 * mu
+    M[3, 3] = 1.0
+    v = np.array([2.0 * s[10] * w, 2.0 * s[11] * w, 2.0 * s[12] * w, n2])
+    if abs(np.linalg.det(M)) < 1e-12 * 64.0 * n2 ** 3:  # too few directions for a sphere
+        return mu * 0.0, 0.0, 0.0, raw_radius, raw_distance, spread
+    theta = np.linalg.solve(M, v)
+    b = theta[0:3]
+    r2 = theta[3] + b[0] * b[0] + b[1] * b[1] + b[2] * b[2]
+    if r2 <= 0.0:
+        return b * 0.0, 0.0, 0.0, raw_radius, raw_distance, spread
+    radius = math.sqrt(r2)
+    residual2 = n4 - 2.0 * (theta @ v) + theta @ (M @ theta)  # mean of (|m|² − 2m·b − c)²
+    return b, radius, math.sqrt(max(residual2, 0.0)) / (2.0 * radius), raw_radius, raw_distance, spread
+
+
+@kernel(inline=True)
+def hard_iron_step(state, coef, m, gap, norm_tol, steady_steps):
+    """(the field sample m (3-tuple, finite) less the offset estimate after updating it,
+    whether the offset was taken or dropped at this sample); state (STATE_SIZE entries) in
+    place, coef from coefficients. gap: steps since the last field sample; norm_tol and
+    steady_steps: the heading guard's norm tolerance and mag_new_time in steps."""
+    cal_steps, spread_min, tol = coef[0], coef[1], coef[2]
+    if cal_steps <= 0.0:
+        return m, False
+    _accumulate(state[SUMS], m, math.exp(-gap / cal_steps))
+    b, radius, distance, raw_radius, raw_distance, spread = _fit(state[SUMS])
+    offset = math.sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2])
+    was_used = state[OFFSET.start] != 0.0 or state[OFFSET.start + 1] != 0.0 or state[OFFSET.start + 2] != 0.0
+    changed = False
+    if (radius > 0.0 and spread >= spread_min * radius and distance < tol * radius
+            and distance < EXPLAINED * raw_distance and offset > norm_tol * radius):
+        state[FIT_STEPS] += gap
+        state[RAW_STEPS] = 0.0
+        if state[FIT_STEPS] >= steady_steps:
+            state[OFFSET] = b
+            changed = not was_used
+    elif raw_distance < tol * raw_radius:
+        state[RAW_STEPS] += gap
+        state[FIT_STEPS] = 0.0
+        if state[RAW_STEPS] >= steady_steps:
+            state[OFFSET] = 0.0
+            changed = was_used
+    else:
+        state[FIT_STEPS] = 0.0
+        state[RAW_STEPS] = 0.0
+    b = state[OFFSET]
+    return (m[0] - b[0], m[1] - b[1], m[2] - b[2]), changed
