@@ -2,7 +2,9 @@
 
 Each doStep(t, h) takes gyr (mean rate over (t, t+h]) and acc, mag at t+h, and steps the
 same compiled block as `attitude estimate` (blocks.online.OnlineEstimator). A parameter
-of 0 means "the method's default"; parameters a method does not have must stay 0.
+at its start value means "the method's default": the start value is 0, or the default
+itself for a parameter that 0 sets to something (scale_error 0: no scale term, k_I 0: no
+bias estimate). Parameters a method does not have must stay at their start values.
 """
 from __future__ import annotations
 
@@ -16,11 +18,15 @@ from blocks.online import OnlineEstimator
 
 
 def tuning_parameters():
-    """Every method's tuning parameters, once each: name → (FMI unit, description)."""
+    """Every method's tuning parameters, once each: name → (FMI unit, description, start
+    value meaning the method's default; see the module docstring)."""
     params = {}
     for m in METHODS.values():
         for p in m.params:
-            params.setdefault(p.name, (fmi_unit(p.unit), f"{p.doc}; 0: the method's default"))
+            start = p.default if p.allow_zero and p.default else 0.0
+            doc = f"{p.doc}; default {start:g}" if start else f"{p.doc}; 0: the method's default"
+            if params.setdefault(p.name, (fmi_unit(p.unit), doc, start))[2] != start:
+                raise ValueError(f"parameter {p.name} needs one start value in every method")
     return params
 
 
@@ -42,8 +48,8 @@ class AttitudeEstimator(ProjectSlave):
         self.parameter("heading", "mag", "heading source: mag (magnetometer, hard iron fitted, guarded against disturbances) or gyro")
         self.parameter("gyro_offset", "off", "on: estimate and remove the gyro offset (at rest and while moving); off")
         self.real("Ts", 0.01, "s", "sample time the estimator expects (other step sizes are re-discretised)", PAR)
-        for name, (unit, doc) in tuning_parameters().items():
-            self.real(name, 0.0, unit, doc, PAR)
+        for name, (unit, doc, start) in tuning_parameters().items():
+            self.real(name, start, unit, doc, PAR)
         self.estimator = None
         self._warned_steps = set()
 
@@ -57,7 +63,8 @@ class AttitudeEstimator(ProjectSlave):
         if self.gyro_offset not in ("on", "off"):
             self.fail(f"invalid parameter: gyro_offset must be 'on' or 'off', got {self.gyro_offset!r}")
             return
-        params = {name: getattr(self, name) for name in tuning_parameters() if getattr(self, name) != 0.0}
+        params = {name: getattr(self, name) for name, (_, _, start) in tuning_parameters().items()
+                  if getattr(self, name) != start}
         try:
             self.estimator = OnlineEstimator(self.method, params, heading=self.heading == "mag",
                                              gyro_offset=self.gyro_offset == "on")

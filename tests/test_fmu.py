@@ -146,8 +146,21 @@ def test_changed_step_size_is_rediscretised_and_logged(fmu_dir, recording, capsy
     assert np.abs(out[:, :4] - np.array(expected)).max() < 1e-9
 
 
+@pytest.mark.parametrize("method, name", [("wiener", "scale_error"), ("mahony", "k_I")])
+def test_estimator_fmu_takes_a_zero_where_zero_is_a_setting(fmu_dir, recording, method, name):
+    """scale_error 0 (no scale term) and k_I 0 (no bias estimate) are settings, not "the
+    default": their FMU start values are the defaults, and 0 reaches the estimator."""
+    gyr, acc = recording
+    runner = _estimator(fmu_dir, method=method, **{name: 0.0})
+    out, _ = runner.run(np.hstack([gyr, acc]), 1 / FS)
+    runner.close()
+    assert np.abs(out[:, :4] - estimate(gyr, acc, FS, method, {name: 0.0}).quat).max() < 1e-9
+    assert np.abs(out[:, :4] - estimate(gyr, acc, FS, method).quat).max() > 1e-6
+
+
 @pytest.mark.parametrize("parameters, message", [
     ({"delta_n": -1.0}, "delta_n must be a finite positive number"),
+    ({"method": "mahony", "scale_error": 0.0}, "unknown parameter 'scale_error'"),
     ({"method": "kalman"}, "unknown method 'kalman'"),
     ({"method": "wiener", "omega_f": 0.1}, "unknown parameter 'omega_f'"),
     ({"heading": "compass"}, "heading must be 'mag' or 'gyro'"),
