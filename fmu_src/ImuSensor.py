@@ -17,7 +17,7 @@ from systems.sensor_model import ImuModel
 
 class ImuSensor(ProjectSlave):
     author = "attitude-fmu"
-    description = "IMU sensor model: gyro noise density and offset, accelerometer noise and offset"
+    description = "IMU sensor model: gyro noise density, offset, scale and misalignment, accelerometer noise and offset"
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
@@ -29,6 +29,9 @@ class ImuSensor(ProjectSlave):
         self.vector("mag", EARTH_FIELD_UT, "uT", "measured magnetic field {c} (ideal)", OUT)
         self.real("delta_n", 0.0, "rad/s/sqrt(Hz)", "gyro white-noise density, one-sided", PAR)
         self.vector("gyr_offset", (0.0, 0.0, 0.0), "rad/s", "constant gyro offset {c}", PAR)
+        for row in "xyz":
+            self.vector(f"gyr_scale_{row}", (0.0, 0.0, 0.0), "1",
+                        f"gyro scale and misalignment error: share of the true rate's {{c}} in gyr_{row}", PAR)
         self.real("acc_noise", 0.0, "m/s2/sqrt(Hz)", "accelerometer white-noise density, one-sided", PAR)
         self.vector("acc_offset", (0.0, 0.0, 0.0), "m/s2", "constant accelerometer offset {c}", PAR)
         self.parameter("seed", 1, "seed of the noise generator", Integer)
@@ -39,6 +42,7 @@ class ImuSensor(ProjectSlave):
             self.model = ImuModel(
                 delta_n=self.delta_n, acc_noise=self.acc_noise,
                 gyr_offset=(self.gyr_offset_x, self.gyr_offset_y, self.gyr_offset_z),
+                gyr_scale=tuple(tuple(getattr(self, f"gyr_scale_{row}_{c}") for c in "xyz") for row in "xyz"),
                 acc_offset=(self.acc_offset_x, self.acc_offset_y, self.acc_offset_z),
             )
             self.rng = np.random.default_rng(self.seed)

@@ -12,16 +12,19 @@ from .motion import AXES, Motion
 
 @dataclass(frozen=True)
 class ImuModel:
-    """Gyro y_g = ω + n + b, accelerometer y_a = f + n_a + acc_offset, magnetometer ideal.
+    """Gyro y_g = (I + S)·ω + n + b, accelerometer y_a = f + n_a + acc_offset, magnetometer ideal.
 
     delta_n: gyro white-noise density, rad/s/√Hz (one-sided; per-sample s.d.
-    delta_n·√(fs/2)); gyr_offset: constant gyro offset b, rad/s (3); acc_noise:
+    delta_n·√(fs/2)); gyr_offset: constant gyro offset b, rad/s (3); gyr_scale: the gyro's
+    scale-factor and misalignment error S (3×3, row i: what axis i adds of each true
+    rate component; 1 = 100 %); acc_noise:
     accelerometer white-noise density, m/s²/√Hz; acc_offset: constant accelerometer
     offset, m/s² (3). Noise enters as unit-normal samples, 6 per sample (gyro, acc).
     """
 
     delta_n: float = 0.0
     gyr_offset: tuple = (0.0, 0.0, 0.0)
+    gyr_scale: tuple = ((0.0, 0.0, 0.0),) * 3
     acc_noise: float = 0.0
     acc_offset: tuple = (0.0, 0.0, 0.0)
 
@@ -34,13 +37,18 @@ class ImuModel:
             v = np.asarray(getattr(self, name), dtype=float)
             if v.shape != (3,) or not np.isfinite(v).all():
                 raise ValueError(f"{name} must be 3 finite numbers, got {getattr(self, name)!r}")
+        S = np.asarray(self.gyr_scale, dtype=float)
+        if S.shape != (3, 3) or not np.isfinite(S).all():
+            raise ValueError(f"gyr_scale must be 3×3 finite numbers, got {self.gyr_scale!r}")
 
     def measure(self, omega, f, noise, fs: float):
         """Measured (gyr, acc) from ideal rate omega, specific force f (…×3) and unit-normal
         noise (…×6: gyro, then accelerometer) at sample rate fs (Hz)."""
         noise = np.asarray(noise)
         scale = math.sqrt(fs / 2.0)
-        gyr = np.asarray(omega) + self.delta_n * scale * noise[..., 0:3] + np.asarray(self.gyr_offset)
+        omega = np.asarray(omega)
+        gyr = (omega + omega @ np.asarray(self.gyr_scale).T + self.delta_n * scale * noise[..., 0:3]
+               + np.asarray(self.gyr_offset))
         acc = np.asarray(f) + self.acc_noise * scale * noise[..., 3:6] + np.asarray(self.acc_offset)
         return gyr, acc
 

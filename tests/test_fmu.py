@@ -230,9 +230,12 @@ def test_non_finite_inputs_hold_the_estimate_and_clear_valid(fmu_dir, recording,
     assert np.abs(out[22:, :4] - ref.quat[20:]).max() < 1e-9
 
 
+GYR_SCALE = ((0.002, 0.01, 0.0), (0.0, -0.003, 0.0), (-0.005, 0.0, 0.004))  # scale and misalignment
+
+
 def _batch_pipeline(duration, seed_motion, seed_imu, delta_n, method="wiener"):
     motion = profile("human").motion().generate(duration, FS, seed_motion)
-    gyr, acc = ImuModel(delta_n=delta_n).apply(motion, seed_imu)
+    gyr, acc = ImuModel(delta_n=delta_n, gyr_scale=GYR_SCALE).apply(motion, seed_imu)
     return motion, estimate(gyr, acc, FS, method, mag=motion.mag)  # the sensor passes the field on
 
 
@@ -240,7 +243,9 @@ def _batch_pipeline(duration, seed_motion, seed_imu, delta_n, method="wiener"):
 def test_ssp_diagram_under_the_master_equals_the_batch_pipeline(fmu_dir, tmp_path, method):
     dn = math.radians(0.1)
     ssp = write_ssp(tmp_path / "human.ssp", fmu_dir, {
-        "motion": {"profile": "human", "seed": 3}, "imu": {"delta_n": dn, "seed": 4},
+        "motion": {"profile": "human", "seed": 3},
+        "imu": {"delta_n": dn, "seed": 4, **{f"gyr_scale_{r}_{c}": GYR_SCALE[i][j]
+                                             for i, r in enumerate("xyz") for j, c in enumerate("xyz")}},
         "estimator": {"method": method}}, 10.0, 1 / FS)
     out = cosimulate(ssp, 10.0, 1 / FS)
     motion, ref = _batch_pipeline(10.0, 3, 4, dn, method)

@@ -37,6 +37,18 @@ def test_sensor_model_noise_density_and_offsets():
         ImuModel(delta_n=-1.0)
 
 
+def test_sensor_model_scale_and_misalignment():
+    """Without noise the gyro reads (I + S)·ω: S·ω is exactly what it adds."""
+    motion = HumanMotion().generate(10.0, 100.0, seed=2)
+    S = ((0.01, -0.002, 0.0), (0.003, 0.0, 0.005), (0.0, 0.0, -0.02))
+    gyr, _ = ImuModel(gyr_scale=S).apply(motion)
+    for i in range(3):
+        added = sum(S[i][j] * motion.gyr[:, j] for j in range(3))
+        assert np.abs(gyr[:, i] - motion.gyr[:, i] - added).max() < 1e-15
+    with pytest.raises(ValueError, match="gyr_scale"):
+        ImuModel(gyr_scale=((0.0, 0.0), (0.0, 0.0)))
+
+
 def test_steady_lever_arm_closed_form():
     m = steady_lever_arm(2.0, 0.2, g=9.81).generate(10.0, 100.0)
     rot = Rotation.from_quat(m.quat, scalar_first=True)

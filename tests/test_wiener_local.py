@@ -21,9 +21,8 @@ SETTLE = 30000  # samples: 300 s, ten time constants of the slowest filter here
 
 def _human(delta_v, rot_rms=1.0, seed=0, duration=3000.0, scale=None, delta_n=DELTA_N):
     motion = HumanMotion(delta_v=delta_v, omega_c=10.0, rot_rms=rot_rms).generate(duration, FS, seed)
-    gyr, acc = ImuModel(delta_n=delta_n).apply(motion, seed=seed + 1)
-    if scale is not None:
-        gyr = gyr + motion.gyr @ scale.T  # scale-factor and misalignment error S·ω
+    imu = ImuModel(delta_n=delta_n) if scale is None else ImuModel(delta_n=delta_n, gyr_scale=scale)
+    gyr, acc = imu.apply(motion, seed=seed + 1)
     return motion, gyr, acc
 
 
