@@ -1,16 +1,16 @@
 """Gyroscope-offset estimator (the "gyro offset estimator" box of Rizun's Fig. 1).
 
-At rest: the gyro and the accelerometer, each low-passed (time constant tau_lp), must stay
-close to their low-passed values (rest_gyr, rest_acc) and the low-passed gyro must stay
-small (rest_gyr_abs) for rest_time seconds; then each gyro sample measures the offset
+At rest: the gyro and the accelerometer, each through a short low-pass (tau_short, which
+takes the white noise above human motion's band out), must stay close to their values
+low-passed over tau_lp (rest_gyr, rest_acc), and the gyro low-passed over tau_lp must
+stay small (rest_gyr_abs), for rest_time seconds; then each gyro sample measures the offset
 with the variance of the gyro's white noise, delta_n²·fs/2, in the same Kalman filter as
 the tracking while moving: a first rest after an uncertain start gives the running mean
 of the rest's samples, and a long rest settles on a window of delta_n/sigma_motion·
-√(tau_motion/2) s (7 s by default), whatever the sample rate. The deviations are tested
-sample by sample, as vqf does: a gyro whose white noise alone comes near rest_gyr
-(δn·√(3·fs/2), e.g. 0.1 °/s/√Hz at 250 Hz) seldom or never rests, and its offset then
-comes from the tracking while moving, which cannot see the component along gravity.
-(Testing mean squares instead, with the noise allowed for, took slow motion for rest.)
+√(tau_motion/2) s (7 s by default), whatever the sample rate. Without the short low-pass
+(raw samples, as vqf tests them) a gyro whose white noise alone comes near rest_gyr
+(δn·√(3·fs/2), e.g. 0.1 °/s/√Hz at 250 Hz) would seldom or never rest; through it the
+noise is δn·√(3/(4·tau_short)), 0.6 °/s for 0.1 °/s/√Hz at any rate.
 
 While moving, the offset's effect on the accelerometer is tracked in the gyro frame (the
 frame integrated from the corrected gyro; R its sensor → gyro-frame rotation), the way
@@ -47,6 +47,8 @@ PARAMS = (
     Param("rest_acc", 0.5, "m/s²", "largest deviation of the accelerometer from its low-pass at rest"),
     Param("rest_time", 1.5, "s", "time the rest conditions must hold"),
     Param("tau_lp", 0.5, "s", "time constant of the low-passes of the rest detection"),
+    Param("tau_short", 0.02, "s", "time constant of the low-pass that takes white noise out of the samples the rest "
+          "detection compares with its low-passes (human motion lies below 8 Hz)"),
     Param("delta_n", math.radians(0.1), "rad/s/√Hz", "gyro noise density, one-sided (datasheet): each sample's weight at rest"),
     Param("tau_acc", 3.0, "s", "time constant of the accelerometer low-pass in the gyro frame (motion tracking)"),
     Param("sigma_init", math.radians(0.5), "rad/s", "uncertainty of the offset before any rest (per axis)"),
@@ -63,8 +65,9 @@ STATE_NAMES = (
     *(f"R{r}_{i}{j}" for r in "xu" for i in "123" for j in "123"),  # Butterworth rows of R
     *(f"Rb{r}_{i}" for r in "xu" for i in "xyz"),  # Butterworth rows of R·b (rad/s)
     *(f"P_{i}{j}" for i in "xyz" for j in "xyz"),  # covariance of the offset estimate, (rad/s)²
+    "gsh_x", "gsh_y", "gsh_z", "ash_x", "ash_y", "ash_z",  # gyro and accelerometer through the short low-pass
 )
-T, QUAT, ACC_LP, R_LP, RB_LP, COV = 10, slice(11, 15), slice(15, 21), slice(21, 39), slice(39, 45), slice(45, 54)
+T, QUAT, ACC_LP, R_LP, RB_LP, COV, SHORT = 10, slice(11, 15), slice(15, 21), slice(21, 39), slice(39, 45), slice(45, 54), 54
 OBSERVED = 0.5  # the least share of an offset's effect H must keep in a direction to update it
 CLIP_SIGMAS = 4.0  # innovations clipped at this many sigma_init
 SETTLE_TAUS = 3.0  # no update before this many tau_acc (the low-pass forgetting its start)
@@ -75,8 +78,8 @@ def resolve(overrides=None) -> dict:
 
 
 def coefficients(params, Ts: float) -> np.ndarray:
-    """[Ts, a_lp, r, rest_gyr, rest_gyr_abs, rest_acc, rest_time, ω_acc·Ts, P0, V, W]:
-    a_lp = 1 − exp(−Ts/τ_lp), r = δn²/(2·Ts) the variance of a gyro sample's white noise
+    """[Ts, a_lp, r, rest_gyr, rest_gyr_abs, rest_acc, rest_time, ω_acc·Ts, P0, V, W, a_short]:
+    a_* = 1 − exp(−Ts/τ_*), r = δn²/(2·Ts) the variance of a gyro sample's white noise
     ((rad/s)²), ω_acc = √2/τ_acc (rad/s); the Kalman filter has the initial variance
     P0 = σ_init², the process noise V = σ_motion²·Ts/τ_motion per sample and, while moving,
     the measurement noise W = σ_motion⁴/V + σ_motion², with which its variance settles on
@@ -86,14 +89,15 @@ def coefficients(params, Ts: float) -> np.ndarray:
     return np.array([Ts, 1.0 - math.exp(-Ts / params["tau_lp"]), params["delta_n"] ** 2 / (2.0 * Ts),
                      params["rest_gyr"], params["rest_gyr_abs"], params["rest_acc"], params["rest_time"],
                      math.sqrt(2.0) / params["tau_acc"] * Ts, params["sigma_init"] ** 2, V,
-                     s2 * s2 / V + s2 if V > 0 else 0.0])
+                     s2 * s2 / V + s2 if V > 0 else 0.0, 1.0 - math.exp(-Ts / params["tau_short"])])
 
 
 def initial_state(coef, gyr0, acc0) -> np.ndarray:
-    """Low-passes on the first samples, not at rest, no offset (variance P0), the gyro
+    """Low-passes (both) on the first samples, not at rest, no offset (variance P0), the gyro
     frame on the sensor, its low-passes settled on acc0 and R = I."""
     state = np.zeros(len(STATE_NAMES))
     state[0:3], state[3:6] = gyr0, acc0
+    state[SHORT:SHORT + 3], state[SHORT + 3:SHORT + 6] = gyr0, acc0
     state[QUAT] = (1.0, 0.0, 0.0, 0.0)
     state[ACC_LP][0:3] = acc0
     state[R_LP][0:9] = np.eye(3).ravel()
@@ -147,8 +151,8 @@ def motion_update(b, P, old, new, r_lp, rb_lp, Ts, W, clip):
 def run(state, coef, gyr, acc, offset, variance):
     """Over N samples: the offset estimate after each sample (N×3, rad/s) and its variance
     per axis (N×3, (rad/s)²)."""
-    Ts, a_lp, r, rest_gyr, rest_gyr_abs, rest_acc, rest_time, wt, P0, V, W = (
-        coef[0], coef[1], coef[2], coef[3], coef[4], coef[5], coef[6], coef[7], coef[8], coef[9], coef[10])
+    Ts, a_lp, r, rest_gyr, rest_gyr_abs, rest_acc, rest_time, wt, P0, V, W, a_short = (
+        coef[0], coef[1], coef[2], coef[3], coef[4], coef[5], coef[6], coef[7], coef[8], coef[9], coef[10], coef[11])
     settle = SETTLE_TAUS * math.sqrt(2.0) * Ts / wt
     clip = CLIP_SIGMAS * math.sqrt(P0)
     Ad, Bd = np.empty((2, 2)), np.empty(2)
@@ -165,8 +169,10 @@ def run(state, coef, gyr, acc, offset, variance):
         for i in range(3):
             state[i] += a_lp * (gyr[k, i] - state[i])
             state[3 + i] += a_lp * (acc[k, i] - state[3 + i])
-            dg2 += (gyr[k, i] - state[i]) ** 2
-            da2 += (acc[k, i] - state[3 + i]) ** 2
+            state[SHORT + i] += a_short * (gyr[k, i] - state[SHORT + i])
+            state[SHORT + 3 + i] += a_short * (acc[k, i] - state[SHORT + 3 + i])
+            dg2 += (state[SHORT + i] - state[i]) ** 2
+            da2 += (state[SHORT + 3 + i] - state[3 + i]) ** 2
             g2 += state[i] ** 2
         still = dg2 < rest_gyr * rest_gyr and da2 < rest_acc * rest_acc and g2 < rest_gyr_abs * rest_gyr_abs
         state[6] = state[6] + Ts if still else 0.0

@@ -61,8 +61,8 @@ def _window(t, period=300.0, rest=60.0, ramp=2.0):
     return np.minimum(up, down)
 
 
-def _motion_with_rests():
-    """An hour of rotation and translation with a 60 s rest every 5 minutes (closed form)."""
+def _motion_with_rests(duration=3600.0, fs=FS):
+    """Rotation and translation with a 60 s rest every 5 minutes (closed form), by default an hour."""
     def orientation(t):
         w = _window(t)
         return Rotation.from_euler("ZYX", np.column_stack([
@@ -72,7 +72,7 @@ def _motion_with_rests():
     def velocity(t):
         return _window(t)[:, None] * 0.3 * np.column_stack([np.sin(2.3 * t), np.cos(1.7 * t), 0.5 * np.sin(3.1 * t)])
 
-    return ClosedFormMotion("rests", orientation, velocity).generate(3600.0, FS)
+    return ClosedFormMotion("rests", orientation, velocity).generate(duration, fs)
 
 
 def test_gyro_offset_converges_and_attitude_stays_bounded_over_an_hour():
@@ -92,6 +92,21 @@ def test_gyro_offset_converges_and_attitude_stays_bounded_over_an_hour():
     print(f"max inclination error with the offset estimator {inclination[after_first_rest:].max():.2f}°, "
           f"without {without[after_first_rest:].max():.2f}°")
     assert without[after_first_rest:].max() > 4 * inclination[after_first_rest:].max()
+
+
+def test_a_noisy_gyro_at_a_high_rate_still_finds_rest():
+    """0.1 °/s/√Hz at 250 Hz: white noise alone deviates about 2 °/s per sample, so a
+    per-sample rest test (tau_short → 0) never finds the first minute's rest; through
+    the short low-pass it does, and the offset is known when the motion starts."""
+    fs = 250.0
+    motion = _motion_with_rests(70.0, fs)
+    offset = np.radians([1.0, -1.0, 1.0])
+    gyr, acc = ImuModel(delta_n=math.radians(0.1), gyr_offset=tuple(offset), acc_noise=0.002).apply(motion, seed=5)
+    at_motion = int(60 * fs)
+    error = lambda params: np.degrees(np.abs(correct_gyro(gyr, acc, fs, params)[1][at_motion] - offset)).max()
+    print(f"offset error when the motion starts: {error({}):.3f} °/s, per-sample test {error({'tau_short': 1e-9}):.3f} °/s")
+    assert error({}) < 0.05
+    assert error({"tau_short": 1e-9}) > 0.5
 
 
 def test_a_short_rest_gives_the_mean_of_its_gyro_samples():
