@@ -39,6 +39,7 @@ from .jit import kernel
 from .methods import Param, resolve_params
 from .quaternion import quat_multiply, quat_normalized, quat_rotate, rotvec_quat
 from .sensor_frame import time_reversed
+from .stepper_system import sample_system
 from .wiener_local import butterworth_zoh
 
 PARAMS = (
@@ -204,6 +205,21 @@ def run(state, coef, gyr, acc, offset, variance):
         for i in range(3):
             offset[k, i] = b[i]
             variance[k, i] = P[i, i]
+
+
+def offset_system(dt: float, params=None, name: str = "gyro_offset"):
+    """Discrete python-control system of the estimator: inputs gyr_raw_x..z (rad/s, the
+    measured gyro) and acc_x..z (m/s²); outputs gyr_x..z, the gyro less the offset
+    estimate after the sample (rad/s), and offset_x..z. x0: initial_state."""
+    coef = coefficients(resolve(params), dt)
+
+    def advance(state, u):
+        offset, variance = np.empty((1, 3)), np.empty((1, 3))
+        run(state, coef, u[0:3].reshape(1, 3).copy(), u[3:6].reshape(1, 3).copy(), offset, variance)
+        return state, np.concatenate([u[0:3] - offset[0], offset[0]])
+
+    return sample_system(advance, [f"{s}_{a}" for s in ("gyr_raw", "acc") for a in "xyz"],
+                         [f"{s}_{a}" for s in ("gyr", "offset") for a in "xyz"], STATE_NAMES, dt, name)
 
 
 def correct(gyr, acc, fs: float, params=None, offline: bool = False):

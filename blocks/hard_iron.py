@@ -38,8 +38,14 @@ PARAMS = (
     Param("mag_cal_tol", 0.05, "1", "largest rms distance of the field from the fitted sphere, relative to its radius"),
 )
 EXPLAINED = 0.5  # the fit's residual must be below this share of the field's own
+STATE_NAMES = (
+    "s_1", "s_mx", "s_my", "s_mz", "s_mxx", "s_mxy", "s_mxz", "s_myy", "s_myz", "s_mzz",  # Σ1, Σm, Σm·mᵀ
+    "s_mx_n2", "s_my_n2", "s_mz_n2", "s_n2", "s_n4",  # Σm·|m|², Σ|m|², Σ|m|⁴ (forgetting sums)
+    "b_x", "b_y", "b_z",  # the offset in use
+    "fit_steps", "raw_steps",  # steps the fit, or the field as it is, has held steady
+)
 SUMS, OFFSET, FIT_STEPS, RAW_STEPS = slice(0, 15), slice(15, 18), 18, 19
-STATE_SIZE = 20  # Σ1, Σm (3), Σm·mᵀ (xx xy xz yy yz zz), Σm·|m|² (3), Σ|m|², Σ|m|⁴; b (3); steady steps of each model
+STATE_SIZE = len(STATE_NAMES)
 
 
 def coefficients(params, Ts: float) -> np.ndarray:
@@ -49,7 +55,7 @@ def coefficients(params, Ts: float) -> np.ndarray:
 
 @kernel(inline=True)
 def _accumulate(s, m, forget):
-    """The running sums s (see STATE_SIZE) after the field sample m, the old sums scaled by forget."""
+    """The running sums s (see STATE_NAMES) after the field sample m, the old sums scaled by forget."""
     n2 = m[0] * m[0] + m[1] * m[1] + m[2] * m[2]
     terms = (1.0, m[0], m[1], m[2], m[0] * m[0], m[0] * m[1], m[0] * m[2], m[1] * m[1], m[1] * m[2],
              m[2] * m[2], m[0] * n2, m[1] * n2, m[2] * n2, n2, n2 * n2)

@@ -36,6 +36,7 @@ from .hard_iron import hard_iron_step
 from .jit import kernel
 from .methods import Param, resolve_params
 from .quaternion import quat_multiply, quat_rotate
+from .stepper_system import sample_system
 
 PARAMS = (
     Param("tau_heading", 10.0, "s", "time constant of the pull towards the magnetometer heading"),
@@ -46,6 +47,11 @@ PARAMS = (
     Param("mag_new_time", 20.0, "s", "how long a field outside the reference's tolerance must stay steady to replace it"),
     Param("mag_new_angle", math.radians(90.0), "rad", "how far the sensor must turn meanwhile (0: no turn)", True),
 ) + hard_iron.PARAMS
+STATE_NAMES = (
+    "psi_c", "ref_norm", "ref_dip", "seen", "cand_norm", "cand_dip", "cand_n", "cand_dot",
+    "cand_q0_w", "cand_q0_x", "cand_q0_y", "cand_q0_z", "steps", "cand_start", "gap",
+    *(f"hard_iron_{n}" for n in hard_iron.STATE_NAMES),
+)  # see initial_state
 REF_NORM, REF_DIP, SEEN = 1, 2, 3
 CAND_NORM, CAND_DIP, CAND_N, CAND_DOT, CAND_Q0 = 4, 5, 6, 7, 8  # q₀ in 8…11
 STEPS, CAND_START, GAP = 12, 13, 14
@@ -74,7 +80,7 @@ def initial_state() -> np.ndarray:
     |q·q₀| since the candidate began, q₀ (4, the orientation then), steps since the
     start-up began, the step the candidate began at, steps since the last field sample,
     then blocks.hard_iron's state]."""
-    state = np.zeros(HARD_IRON.stop)
+    state = np.zeros(len(STATE_NAMES))
     state[CAND_DOT] = 1.0
     return state
 
@@ -170,6 +176,22 @@ def run(state, coef, quat, mag, out, accepted, offset):
         accepted[k] = ok
         for i in range(3):
             offset[k, i] = state[HARD_IRON_OFFSET + i]
+
+
+def heading_system(dt: float, params=None, name: str = "heading"):
+    """Discrete python-control system of the heading stage: inputs q_w..z (the attitude
+    filter's orientation) and mag_x..z (µT); outputs qh_w..z, the orientation with
+    magnetometer heading, and mag_offset_x..z, the hard-iron estimate. x0: initial_state()."""
+    coef = coefficients(resolve(params), dt)
+
+    def advance(state, u):
+        out, accepted, offset = np.empty((1, 4)), np.empty(1, dtype=np.bool_), np.empty((1, 3))
+        run(state, coef, u[0:4].reshape(1, 4).copy(), u[4:7].reshape(1, 3).copy(), out, accepted, offset)
+        return state, np.concatenate([out[0], offset[0]])
+
+    return sample_system(advance, [f"q_{c}" for c in "wxyz"] + [f"mag_{c}" for c in "xyz"],
+                         [f"qh_{c}" for c in "wxyz"] + [f"mag_offset_{c}" for c in "xyz"],
+                         STATE_NAMES, dt, name)
 
 
 def with_magnetometer(quat, mag, fs: float, params=None):

@@ -5,11 +5,15 @@ from __future__ import annotations
 import control
 import numpy as np
 
+from blocks import gyro_offset
+from blocks.heading import heading_system
+from blocks.heading import initial_state as heading_initial_state
 from blocks.methods import estimator_system, stepper
+from blocks.quaternion import quat_rotate
 from blocks.sensor_frame import GRAVITY_OUTPUTS, QUAT_NAMES
 
 from .errors import inclination_error
-from .motion import AXES, HumanMotion
+from .motion import AXES, EARTH_FIELD_UT, HumanMotion
 from .sensor_model import ImuModel
 
 NOISE_INPUTS = [f"eps_{s}_{a}" for s in "vw" for a in AXES] + [f"{s}_{a}" for s in ("n", "na") for a in AXES]
@@ -28,27 +32,51 @@ def attitude_error_system(fs: float, name: str = "error"):
                          outputs=["incl_err"], dt=1.0 / fs, name=name)
 
 
+def magnetometer_system(fs: float, name: str = "magnetometer"):
+    """Static block: the ideal field mag_* (µT, sensor coordinates) at the orientation qt_*
+    (EARTH_FIELD_UT in the earth frame, as systems.motion.Motion.mag)."""
+    def output(t, x, u, params):
+        return np.array(quat_rotate((u[0], -u[1], -u[2], -u[3]), EARTH_FIELD_UT))
+
+    return control.nlsys(None, output, inputs=["qt_w", "qt_x", "qt_y", "qt_z"],
+                         outputs=[f"mag_{a}" for a in AXES], dt=1.0 / fs, name=name)
+
+
 def closed_loop(motion: HumanMotion, imu: ImuModel, fs: float, method: str = "wiener",
-                params: dict | None = None):
+                params: dict | None = None, offset: bool = False, heading: bool = False):
     """The diagram and its initial state (estimator at rest on g·ẑ, motion level at rest).
 
-    Inputs: NOISE_INPUTS (unit-normal samples); outputs: incl_err (rad), ghat_*, q_*.
+    offset: the gyro-offset estimator (blocks.gyro_offset, its low-passes at rest on g·ẑ)
+    between sensor and estimator; heading: the heading stage (blocks.heading) on the
+    estimator's orientation and the magnetometer. Inputs: NOISE_INPUTS (unit-normal
+    samples); outputs: incl_err (rad), ghat_*, q_*, with offset the gyro offset estimate
+    offset_* (rad/s), with heading qh_* and the hard-iron estimate mag_offset_* (µT).
     """
-    blocks = [motion.system(fs), imu.system(fs), estimator_system(method, params, 1.0 / fs),
-              attitude_error_system(fs)]
-    diagram = control.interconnect(
-        blocks, inplist=NOISE_INPUTS, outlist=["incl_err"] + GRAVITY_OUTPUTS + QUAT_NAMES,
-        name="closed_loop",
-    )
-    start = stepper(method, tuple(sorted((params or {}).items())), 1.0 / fs).initial_state([0.0, 0.0, motion.g])
-    x0 = np.concatenate([motion.initial_state(), start])
-    return diagram, x0
+    dt = 1.0 / fs
+    sensor = imu.system(fs)
+    estimator = [estimator_system(method, params, dt)]
+    states = [motion.initial_state()]
+    if offset:
+        sensor.update_names(outputs=[f"{s}_{a}" for s in ("gyr_raw", "acc") for a in AXES])
+        estimator.insert(0, gyro_offset.offset_system(dt))
+        states.append(gyro_offset.initial_state(gyro_offset.coefficients(gyro_offset.resolve(), dt),
+                                                np.zeros(3), np.array([0.0, 0.0, motion.g])))
+    states.append(stepper(method, tuple(sorted((params or {}).items())), dt).initial_state([0.0, 0.0, motion.g]))
+    outputs = ["incl_err"] + GRAVITY_OUTPUTS + QUAT_NAMES + ([f"offset_{a}" for a in AXES] if offset else [])
+    if heading:
+        estimator += [magnetometer_system(fs), heading_system(dt)]
+        states.append(heading_initial_state())
+        outputs += [f"qh_{c}" for c in "wxyz"] + [f"mag_offset_{a}" for a in AXES]
+    diagram = control.interconnect([motion.system(fs), sensor, *estimator, attitude_error_system(fs)],
+                                   inplist=NOISE_INPUTS, outlist=outputs, outputs=outputs, name="closed_loop")
+    return diagram, np.concatenate(states)
 
 
 def simulate_closed_loop(motion: HumanMotion, imu: ImuModel, fs: float, duration: float,
-                         method: str = "wiener", params: dict | None = None, seed: int = 0):
-    """Short run of the diagram with fixed-seed noise: (noise N×9, response)."""
-    diagram, x0 = closed_loop(motion, imu, fs, method, params)
+                         method: str = "wiener", params: dict | None = None, seed: int = 0,
+                         offset: bool = False, heading: bool = False):
+    """Short run of the diagram (see closed_loop) with fixed-seed noise: (noise N×12, response)."""
+    diagram, x0 = closed_loop(motion, imu, fs, method, params, offset, heading)
     n = int(round(duration * fs))
     noise = np.random.default_rng(seed).standard_normal((n, len(NOISE_INPUTS)))
     t = np.arange(n) / fs

@@ -10,13 +10,13 @@ import math
 from dataclasses import dataclass
 from typing import Callable
 
-import control
 import numpy as np
 from scipy.spatial.transform import Rotation
 
 from blocks.earth_filters import STANDARD_GRAVITY
 from blocks.jit import kernel
 from blocks.quaternion import quat_multiply, quat_normalized, quat_rotate, rotvec_quat
+from blocks.stepper_system import sample_system
 
 AXES = ("x", "y", "z")
 EARTH_FIELD_UT = (0.0, 20.0, -45.0)  # magnetic field in ENU, µT: northwards and down
@@ -102,19 +102,14 @@ class HumanMotion:
         noise per sample); states v (m/s), omega (rad/s), q; outputs TRUTH_OUTPUTS."""
         coef = self.coefficients(fs)
 
-        def advance(x, u):
-            state = np.array(x, dtype=float)
+        def advance(state, u):
             out = np.empty((1, 10))
-            _human_run(state, np.asarray(u, dtype=float).reshape(1, 6), coef, out)
+            _human_run(state, u.reshape(1, 6), coef, out)
             return state, out[0]
 
-        return control.nlsys(
-            lambda t, x, u, p: advance(x, u)[0],
-            lambda t, x, u, p: advance(x, u)[1],
-            inputs=[f"eps_{s}_{a}" for s in "vw" for a in AXES], outputs=TRUTH_OUTPUTS,
-            states=[f"v_{a}" for a in AXES] + [f"w_{a}" for a in AXES] + ["qm_w", "qm_x", "qm_y", "qm_z"],
-            dt=coef[4], name=name,
-        )
+        return sample_system(
+            advance, [f"eps_{s}_{a}" for s in "vw" for a in AXES], TRUTH_OUTPUTS,
+            [f"v_{a}" for a in AXES] + [f"w_{a}" for a in AXES] + ["qm_w", "qm_x", "qm_y", "qm_z"], coef[4], name)
 
     @staticmethod
     def initial_state() -> np.ndarray:
