@@ -6,6 +6,8 @@ import json
 import os
 import sys
 
+import numpy as np
+
 from blocks.methods import METHODS
 from blocks.methods import method as known_method
 
@@ -121,6 +123,13 @@ def cmd_estimate(args) -> int:
                       gyro_offset=args.gyro_offset == "on", mag=rec.mag if args.heading == "mag" else None)
     write_estimate(args.out, rec.t, result.quat, result.up)
     print(f"attitude: {len(rec.gyr)} samples at {rec.fs:g} Hz, method {args.method} → {args.out}", file=sys.stderr)
+    if result.offset is not None:
+        print("attitude: gyro offset estimate at the end "
+              f"({', '.join(f'{v:.3f}' for v in np.degrees(result.offset[-1]))}) °/s", file=sys.stderr)
+    if result.mag_accepted is not None:
+        print(f"attitude: magnetometer samples used for heading {100 * result.mag_accepted.mean():.0f} %, "
+              f"hard-iron offset at the end ({', '.join(f'{v:.1f}' for v in result.mag_offset[-1])}) µT",
+              file=sys.stderr)
     return 0
 
 

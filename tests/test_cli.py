@@ -68,7 +68,7 @@ def test_estimate_without_t_column_needs_fs_and_honours_units(tmp_path, imu):
     assert np.abs(_read_output(out)[1][:, 1:5] - ref.quat).max() < 1e-8
 
 
-def test_estimate_reads_a_broad_mat_recording(tmp_path, imu):
+def test_estimate_reads_a_broad_mat_recording(tmp_path, imu, capsys):
     gyr, acc = imu
     mag = np.tile([0.0, 20.0, -45.0], (len(gyr), 1))
     savemat(tmp_path / "rec.mat", {"imu_gyr": gyr, "imu_acc": acc, "imu_mag": mag,
@@ -78,6 +78,11 @@ def test_estimate_reads_a_broad_mat_recording(tmp_path, imu):
         assert main(["estimate", str(tmp_path / "rec.mat"), "--out", str(out), "--heading", heading]) == 0
         ref = estimate(gyr, acc, FS, gyro_offset=True, mag=ref_mag)
         assert np.abs(_read_output(out)[1][:, 1:5] - ref.quat).max() < 1e-9
+        # the summary names the offset estimates, the hard iron only with the magnetometer
+        err = capsys.readouterr().err
+        b = np.degrees(ref.offset[-1])
+        assert f"gyro offset estimate at the end ({b[0]:.3f}, {b[1]:.3f}, {b[2]:.3f}) °/s" in err
+        assert ("hard-iron offset at the end (0.0, 0.0, 0.0) µT" in err) == (heading == "mag")
 
 
 def _bad_inputs(tmp_path, gyr, acc):
