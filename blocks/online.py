@@ -11,6 +11,7 @@ from .gyro_offset import coefficients as offset_coefficients
 from .gyro_offset import initial_state as offset_initial_state
 from .gyro_offset import resolve as offset_resolve
 from .gyro_offset import run as offset_run
+from .heading import HARD_IRON_OFFSET
 from .heading import coefficients as heading_coefficients
 from .heading import heading_step
 from .heading import initial_state as heading_initial_state
@@ -103,6 +104,11 @@ class OnlineEstimator:
     @property
     def ready(self) -> bool:
         return self.state is not None
+
+    @property
+    def mag_offset(self) -> np.ndarray:
+        """The magnetometer's hard-iron offset estimate (µT, blocks.hard_iron; 0 until one is proven)."""
+        return self._heading_state[HARD_IRON_OFFSET:HARD_IRON_OFFSET + 3]
 
     def step(self, gyr, acc, Ts: float, mag=(0.0, 0.0, 0.0)) -> bool:
         """Take one sample: gyr (rad/s) over the last Ts seconds, acc (m/s²) and mag (µT) now."""

@@ -43,6 +43,9 @@ class AttitudeEstimator(ProjectSlave):
         self.vector("g", (0.0, 0.0, 1.0), "1", "estimated unit up-vector {c}, sensor coordinates", OUT)
         for name in ("roll", "pitch", "yaw"):
             self.real(name, 0.0, "rad", f"{name} (Z-Y-X Euler angles of q; derived output)", OUT)
+        self.vector("gyr_offset", (0.0, 0.0, 0.0), "rad/s", "estimated gyro offset {c} (gyro_offset on; else 0)", OUT)
+        self.vector("mag_offset", (0.0, 0.0, 0.0), "uT", "estimated hard-iron offset {c} of the magnetometer "
+                    "(heading mag; 0 until one is proven)", OUT)
         self.boolean_output("valid", False, "an estimate is available and the last inputs were finite")
         self.parameter("method", "wiener", f"estimator: {', '.join(METHODS)}")
         self.parameter("heading", "mag", "heading source: mag (magnetometer, hard iron fitted, guarded against disturbances) or gyro")
@@ -91,6 +94,8 @@ class AttitudeEstimator(ProjectSlave):
         if self.valid:
             (self.q_w, self.q_x, self.q_y, self.q_z, self.g_x, self.g_y, self.g_z,
              self.roll, self.pitch, self.yaw) = io[6:16].tolist()
+            self.gyr_offset_x, self.gyr_offset_y, self.gyr_offset_z = self.estimator.offset[0].tolist()
+            self.mag_offset_x, self.mag_offset_y, self.mag_offset_z = self.estimator.mag_offset.tolist()
         elif not all(math.isfinite(v) for v in io[0:6].tolist()):
             self.log(f"t={current_time:g}: non-finite input; estimate held", Fmi2Status.warning)
         return True

@@ -20,6 +20,7 @@ from systems.fmu_build import FMU_NAMES, build
 from systems.motion import HumanMotion, profile
 from systems.sensor_model import ImuModel
 from systems.ssp import write_ssp
+from tests.test_real_data import _turns_with_field
 
 INPUTS = [f"{s}_{a}" for s in ("gyr", "acc") for a in "xyz"]
 OUTPUTS = ["q_w", "q_x", "q_y", "q_z", "g_x", "g_y", "g_z"]
@@ -79,20 +80,38 @@ def test_estimator_fmu_heading_from_its_magnetometer_inputs_equals_the_batch_pat
     assert np.abs(out[:, :4] - estimate(gyr, acc, FS).quat).max() > 1e-3  # the field was used
 
 
+def test_estimator_fmu_reports_the_hard_iron_estimate_of_the_batch_path(fmu_dir):
+    """150 s of turning with 18 µT of hard iron on the magnetometer (blocks.hard_iron takes
+    it at 75 s): the FMU's mag_offset outputs are the batch path's estimate."""
+    motion, gyr, acc, mag = _turns_with_field()
+    n = int(150 * FS)
+    gyr, acc, mag = gyr[:n], acc[:n], mag[:n] + [15.0, -5.0, 8.0]
+    runner = FmuRunner(fmu_dir / "AttitudeEstimator.fmu", {}, INPUTS + ["mag_x", "mag_y", "mag_z"],
+                       OUTPUTS + ["mag_offset_x", "mag_offset_y", "mag_offset_z"])
+    out, _ = runner.run(np.hstack([gyr, acc, mag]), 1 / FS)
+    runner.close()
+    ref = estimate(gyr, acc, FS, mag=mag)
+    assert np.abs(out[:, :4] - ref.quat).max() < 1e-9
+    assert np.abs(out[:, 7:10] - ref.mag_offset).max() < 1e-9
+    assert np.abs(out[-1, 7:10] - [15.0, -5.0, 8.0]).max() < 0.5
+
+
 def test_estimator_fmu_with_gyro_offset_on_equals_the_batch_path(fmu_dir):
     """gyro_offset = "on": blocks.gyro_offset per step, as the batch path's gyro_offset=True;
     with an ImuSensor-style offset of 1 °/s it removes the 3° error the filter has without."""
     motion = HumanMotion(delta_v=0.25).generate(120.0, FS, seed=3)
     offset = np.radians([1.0, -1.0, 0.5])
     gyr, acc = ImuModel(delta_n=math.radians(0.02), acc_noise=0.002, gyr_offset=tuple(offset)).apply(motion, seed=4)
-    runner = _estimator(fmu_dir, gyro_offset="on")
+    runner = FmuRunner(fmu_dir / "AttitudeEstimator.fmu", {"gyro_offset": "on"}, INPUTS,
+                       OUTPUTS + ["gyr_offset_x", "gyr_offset_y", "gyr_offset_z"])
     out, valid = runner.run(np.hstack([gyr, acc]), 1 / FS)
     runner.close()
     ref = estimate(gyr, acc, FS, gyro_offset=True)
     assert valid.all()
     assert np.abs(out[:, :4] - ref.quat).max() < 1e-9
+    assert np.abs(out[:, 7:10] - ref.offset).max() < 1e-12  # the estimate itself, an output
     last = slice(int(60 * FS), None)
-    with_offset = np.degrees(inclination_error(out[last, 4:], motion.up[last])).max()
+    with_offset = np.degrees(inclination_error(out[last, 4:7], motion.up[last])).max()
     without = np.degrees(inclination_error(estimate(gyr, acc, FS).up[last], motion.up[last])).max()
     print(f"max inclination error after 60 s: gyro_offset on {with_offset:.2f}°, off {without:.2f}°")
     assert with_offset < 1.0 < 2.0 < without
