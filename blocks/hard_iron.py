@@ -19,8 +19,8 @@ new reference field must stay steady (blocks.heading's mag_new_time):
 Then b follows the fit; it is reset to 0 once the field as it is stays within
 mag_cal_tol of a sphere about 0 for the same time, and kept otherwise (a disturbance
 passing by does not undo a calibration). When b is taken or dropped, the field it leaves
-is proven homogeneous, and the heading stage starts afresh from it. Soft iron (a scaled, skewed sphere) is not
-modelled. mag_cal_time = 0 switches the estimate off.
+is proven homogeneous, and the heading stage starts afresh from it. Soft iron (a scaled,
+skewed sphere) is not modelled. mag_cal_time = 0 switches the estimate off.
 """
 from __future__ import annotations
 
