@@ -43,14 +43,17 @@ from .stepper_system import sample_system
 from .wiener_local import butterworth_zoh
 
 PARAMS = (
-    Param("rest_gyr", math.radians(2.0), "rad/s", "largest deviation of the gyro from its low-pass at rest"),
+    Param("rest_gyr", math.radians(2.0), "rad/s",
+          "largest deviation of the gyro (through tau_short) from its low-pass at rest"),
     Param("rest_gyr_abs", math.radians(5.0), "rad/s", "largest low-passed gyro norm at rest (offset included)"),
-    Param("rest_acc", 0.5, "m/s²", "largest deviation of the accelerometer from its low-pass at rest"),
+    Param("rest_acc", 0.5, "m/s²",
+          "largest deviation of the accelerometer (through tau_short) from its low-pass at rest"),
     Param("rest_time", 1.5, "s", "time the rest conditions must hold"),
     Param("tau_lp", 0.5, "s", "time constant of the low-passes of the rest detection"),
     Param("tau_short", 0.02, "s", "time constant of the low-pass that takes white noise out of the samples the rest "
           "detection compares with its low-passes (human motion lies below 8 Hz)"),
-    Param("delta_n", math.radians(0.1), "rad/s/√Hz", "gyro noise density, one-sided (datasheet): each sample's weight at rest"),
+    Param("delta_n", math.radians(0.1), "rad/s/√Hz",
+          "gyro noise density, one-sided (datasheet): each sample's weight at rest"),
     Param("tau_acc", 3.0, "s", "time constant of the accelerometer low-pass in the gyro frame (motion tracking)"),
     Param("sigma_init", math.radians(0.5), "rad/s", "uncertainty of the offset before any rest (per axis)"),
     Param("sigma_motion", math.radians(0.1), "rad/s", "uncertainty the tracking while moving settles on (per axis)"),

@@ -64,32 +64,44 @@ def _accumulate(s, m, forget):
 
 
 @kernel(inline=True)
-def _fit(s):
-    """(b (3), radius, rms distance from the fitted sphere, the same for the sphere about 0,
-    s.d. of the field across its smallest axis), all in the field's unit; radius 0: no fit."""
+def _moments(s):
+    """The field's mean (3) and second moment (3×3) from the sums s."""
     w = 1.0 / s[0]
-    mu = np.array([s[1], s[2], s[3]]) * w
-    second = np.array([[s[4], s[5], s[6]], [s[5], s[7], s[8]], [s[6], s[8], s[9]]]) * w
-    n2, n4 = s[13] * w, s[14] * w
+    return (np.array([s[1], s[2], s[3]]) * w,
+            np.array([[s[4], s[5], s[6]], [s[5], s[7], s[8]], [s[6], s[8], s[9]]]) * w)
+
+
+@kernel(inline=True)
+def _spread(s):
+    """The s.d. of the field across its smallest axis (the field's unit)."""
+    mu, second = _moments(s)
+    return math.sqrt(max(np.linalg.eigvalsh(second - np.outer(mu, mu))[0], 0.0))
+
+
+@kernel(inline=True)
+def _fit(s):
+    """(b (3), radius, rms distance from the fitted sphere, the same for the sphere about 0),
+    all in the field's unit; radius 0: no fit."""
+    mu, second = _moments(s)
+    n2, n4 = s[13] / s[0], s[14] / s[0]
     raw_radius = math.sqrt(n2)
     raw_distance = math.sqrt(max(n4 - n2 * n2, 0.0)) / (2.0 * raw_radius)
-    spread = math.sqrt(max(np.linalg.eigvalsh(second - np.outer(mu, mu))[0], 0.0))
     M = np.empty((4, 4))
     M[0:3, 0:3] = 4.0 * second
     M[0:3, 3] = 2.0 * mu
     M[3, 0:3] = 2.0 * mu
     M[3, 3] = 1.0
-    v = np.array([2.0 * s[10] * w, 2.0 * s[11] * w, 2.0 * s[12] * w, n2])
+    v = np.array([2.0 * s[10] / s[0], 2.0 * s[11] / s[0], 2.0 * s[12] / s[0], n2])
     if abs(np.linalg.det(M)) < 1e-12 * 64.0 * n2 ** 3:  # too few directions for a sphere
-        return mu * 0.0, 0.0, 0.0, raw_radius, raw_distance, spread
+        return mu * 0.0, 0.0, 0.0, raw_radius, raw_distance
     theta = np.linalg.solve(M, v)
     b = theta[0:3]
     r2 = theta[3] + b[0] * b[0] + b[1] * b[1] + b[2] * b[2]
     if r2 <= 0.0:
-        return b * 0.0, 0.0, 0.0, raw_radius, raw_distance, spread
+        return b * 0.0, 0.0, 0.0, raw_radius, raw_distance
     radius = math.sqrt(r2)
     residual2 = n4 - 2.0 * (theta @ v) + theta @ (M @ theta)  # mean of (|m|² − 2m·b − c)²
-    return b, radius, math.sqrt(max(residual2, 0.0)) / (2.0 * radius), raw_radius, raw_distance, spread
+    return b, radius, math.sqrt(max(residual2, 0.0)) / (2.0 * radius), raw_radius, raw_distance
 
 
 @kernel(inline=True)
@@ -102,12 +114,12 @@ def hard_iron_step(state, coef, m, gap, norm_tol, steady_steps):
     if cal_steps <= 0.0:
         return m, False
     _accumulate(state[SUMS], m, math.exp(-gap / cal_steps))
-    b, radius, distance, raw_radius, raw_distance, spread = _fit(state[SUMS])
+    b, radius, distance, raw_radius, raw_distance = _fit(state[SUMS])
     offset = math.sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2])
     was_used = state[OFFSET.start] != 0.0 or state[OFFSET.start + 1] != 0.0 or state[OFFSET.start + 2] != 0.0
     changed = False
-    if (radius > 0.0 and spread >= spread_min * radius and distance < tol * radius
-            and distance < EXPLAINED * raw_distance and offset > norm_tol * radius):
+    if (radius > 0.0 and distance < tol * radius and distance < EXPLAINED * raw_distance
+            and offset > norm_tol * radius and _spread(state[SUMS]) >= spread_min * radius):
         state[FIT_STEPS] += gap
         state[RAW_STEPS] = 0.0
         if state[FIT_STEPS] >= steady_steps:

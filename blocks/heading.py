@@ -116,48 +116,57 @@ def _new_reference(state, coef, q, norm, dip):
 
 
 @kernel(inline=True)
+def _field_sample(state, coef, q, m, horizontal):
+    """Take the field m (earth frame, turned by ψ_c; its horizontal norm > 0) into ψ_c and
+    the reference; whether it was used."""
+    clip = coef[4]
+    norm = math.sqrt(horizontal * horizontal + m[2] * m[2])
+    dip = math.atan2(-m[2], horizontal)
+    gap, state[GAP] = state[GAP], 0.0
+    if state[SEEN] == 0.0:
+        state[STEPS] = 1.0
+    state[SEEN] += 1.0
+    start = 1.0 / state[STEPS] > coef[7]  # within tau_heading of the start
+    ok = False
+    if not start:
+        ok = _steady(norm, dip, state[REF_NORM], state[REF_DIP], coef[2], coef[3])
+        if ok:
+            state[CAND_N] = 0.0
+        elif _new_reference(state, coef, q, norm, dip):
+            state[SEEN], state[STEPS], start = 1.0, 1.0, True  # a proven field: start afresh
+    if start:  # running means, every sample
+        ok = True
+        state[0] += math.atan2(m[0], m[1]) / state[SEEN]
+        state[REF_NORM] += (norm - state[REF_NORM]) / state[SEEN]
+        state[REF_DIP] += (dip - state[REF_DIP]) / state[SEEN]
+    elif ok:  # first-order pulls over the time since the last field sample
+        state[0] += (1.0 - math.exp(-gap * coef[0])) * min(clip, max(-clip, math.atan2(m[0], m[1])))
+        a_reference = 1.0 - math.exp(-gap * coef[1])
+        state[REF_NORM] += a_reference * (norm - state[REF_NORM])
+        state[REF_DIP] += a_reference * (dip - state[REF_DIP])
+    return ok
+
+
+@kernel(inline=True)
 def heading_step(state, coef, q, m_sensor):
     """One step: (q turned by the updated ψ_c, whether the field was used). q is the
     attitude filter's orientation (4-tuple), m_sensor the field (3-tuple; a NaN: no field
     sample this step, a slower magnetometer); state in place. Times count steps, so a
     slower magnetometer keeps the time constants in seconds."""
-    clip = coef[4]
     state[GAP] += 1.0
     if state[SEEN] > 0.0:
         state[STEPS] += 1.0
+    ok = False
     n2 = m_sensor[0] * m_sensor[0] + m_sensor[1] * m_sensor[1] + m_sensor[2] * m_sensor[2]
     if math.isfinite(n2) and n2 > 0.0:  # a field sample (not NaN: missing, not all 0: none)
         m_sensor, proven = hard_iron_step(state[HARD_IRON], coef[8:11], m_sensor, state[GAP], coef[2], coef[5])
         if proven:  # a field freed of (or back without) an offset: start afresh from it
             state[SEEN] = 0.0
-    half = 0.5 * state[0]
-    m = quat_rotate(quat_multiply((math.cos(half), 0.0, 0.0, math.sin(half)), q), m_sensor)
-    horizontal = math.sqrt(m[0] * m[0] + m[1] * m[1])
-    norm = math.sqrt(horizontal * horizontal + m[2] * m[2])
-    ok = False
-    if math.isfinite(norm) and horizontal > 0.0:  # else no sample (NaN: missing, all 0: none)
-        dip = math.atan2(-m[2], horizontal)
-        gap, state[GAP] = state[GAP], 0.0
-        if state[SEEN] == 0.0:
-            state[STEPS] = 1.0
-        state[SEEN] += 1.0
-        start = 1.0 / state[STEPS] > coef[7]  # within tau_heading of the start
-        if not start:
-            ok = _steady(norm, dip, state[REF_NORM], state[REF_DIP], coef[2], coef[3])
-            if ok:
-                state[CAND_N] = 0.0
-            elif _new_reference(state, coef, q, norm, dip):
-                state[SEEN], state[STEPS], start = 1.0, 1.0, True  # a proven field: start afresh
-        if start:  # running means, every sample
-            ok = True
-            state[0] += math.atan2(m[0], m[1]) / state[SEEN]
-            state[REF_NORM] += (norm - state[REF_NORM]) / state[SEEN]
-            state[REF_DIP] += (dip - state[REF_DIP]) / state[SEEN]
-        elif ok:  # first-order pulls over the time since the last field sample
-            state[0] += (1.0 - math.exp(-gap * coef[0])) * min(clip, max(-clip, math.atan2(m[0], m[1])))
-            a_reference = 1.0 - math.exp(-gap * coef[1])
-            state[REF_NORM] += a_reference * (norm - state[REF_NORM])
-            state[REF_DIP] += a_reference * (dip - state[REF_DIP])
+        half = 0.5 * state[0]
+        m = quat_rotate(quat_multiply((math.cos(half), 0.0, 0.0, math.sin(half)), q), m_sensor)
+        horizontal = math.sqrt(m[0] * m[0] + m[1] * m[1])
+        if horizontal > 0.0:  # a field with a heading
+            ok = _field_sample(state, coef, q, m, horizontal)
     state[0] = math.atan2(math.sin(state[0]), math.cos(state[0]))
     half = 0.5 * state[0]
     return quat_multiply((math.cos(half), 0.0, 0.0, math.sin(half)), q), ok
