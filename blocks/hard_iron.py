@@ -16,11 +16,19 @@ new reference field must stay steady (blocks.heading's mag_new_time):
 - the offset is larger than the guard's norm tolerance (mag_norm_tol of the radius):
   smaller ones are the guard's business, and a calibrated magnetometer in a lab whose
   field is not quite homogeneous is left alone.
-Then b follows the fit; it is reset to 0 once the field as it is stays within
-mag_cal_tol of a sphere about 0 for the same time, and kept otherwise (a disturbance
-passing by does not undo a calibration). When b is taken or dropped, the field it leaves
-is proven homogeneous, and the heading stage starts afresh from it. Soft iron (a scaled,
-skewed sphere) is not modelled. mag_cal_time = 0 switches the estimate off.
+Then b follows the fit; it is reset to 0 once the field as it is, covering every
+direction, stays within mag_cal_tol of a sphere about 0 for the same time, and kept
+otherwise (a disturbance passing by, or a long rest, does not undo a calibration). When
+b is taken or dropped, the field it leaves is proven homogeneous, and the heading stage
+starts afresh from it.
+
+The field can change for good within the window (a magnet put on or taken off): once
+the window, covering every direction, fits a sphere (about b or about 0) but the latest
+samples (mean square distance low-passed over mag_cal_recent) lie more than mag_cal_tol
+off it, the sums start afresh from the latest sample, so that the fit proves the new
+field within about a minute instead of mixing it with the old one for several.
+Soft iron (a scaled, skewed sphere) is not modelled. mag_cal_time = 0 switches the
+estimate off.
 """
 from __future__ import annotations
 
@@ -36,6 +44,8 @@ PARAMS = (
           True),
     Param("mag_cal_spread", 0.1, "1", "least s.d. of the field across its smallest axis, relative to the fit's radius"),
     Param("mag_cal_tol", 0.05, "1", "largest rms distance of the field from the fitted sphere, relative to its radius"),
+    Param("mag_cal_recent", 2.0, "s", "time constant over which the latest field samples are held against the sphere "
+          "the recent ones fit"),
 )
 EXPLAINED = 0.5  # the fit's residual must be below this share of the field's own
 STATE_NAMES = (
@@ -43,14 +53,16 @@ STATE_NAMES = (
     "s_mx_n2", "s_my_n2", "s_mz_n2", "s_n2", "s_n4",  # Σm·|m|², Σ|m|², Σ|m|⁴ (forgetting sums)
     "b_x", "b_y", "b_z",  # the offset in use
     "fit_steps", "raw_steps",  # steps the fit, or the field as it is, has held steady
+    "recent_fit", "recent_raw",  # the latest samples' mean square distance from either sphere, relative to its radius
 )
-SUMS, OFFSET, FIT_STEPS, RAW_STEPS = slice(0, 15), slice(15, 18), 18, 19
+SUMS, OFFSET, FIT_STEPS, RAW_STEPS, RECENT_FIT, RECENT_RAW = slice(0, 15), slice(15, 18), 18, 19, 20, 21
 STATE_SIZE = len(STATE_NAMES)
 
 
 def coefficients(params, Ts: float) -> np.ndarray:
-    """[mag_cal_time/Ts (steps; 0: off), mag_cal_spread, mag_cal_tol]."""
-    return np.array([params["mag_cal_time"] / Ts, params["mag_cal_spread"], params["mag_cal_tol"]])
+    """[mag_cal_time/Ts (steps; 0: off), mag_cal_spread, mag_cal_tol, mag_cal_recent/Ts (steps)]."""
+    return np.array([params["mag_cal_time"] / Ts, params["mag_cal_spread"], params["mag_cal_tol"],
+                     params["mag_cal_recent"] / Ts])
 
 
 @kernel(inline=True)
@@ -105,27 +117,50 @@ def _fit(s):
 
 
 @kernel(inline=True)
+def _recent(state, index, m, centre, radius, a):
+    """Low-pass (weight a) of the squared distance of m from the sphere (centre, radius),
+    relative to the radius, into state[index]; its value."""
+    if radius > 0.0:
+        d = m[0] - centre[0], m[1] - centre[1], m[2] - centre[2]
+        e = math.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) / radius - 1.0
+        state[index] += a * (e * e - state[index])
+    return state[index]
+
+
+@kernel(inline=True)
 def hard_iron_step(state, coef, m, gap, norm_tol, steady_steps):
     """(the field sample m (3-tuple, finite) less the offset estimate after updating it,
     whether the offset was taken or dropped at this sample); state (STATE_SIZE entries) in
     place, coef from coefficients. gap: steps since the last field sample; norm_tol and
     steady_steps: the heading guard's norm tolerance and mag_new_time in steps."""
-    cal_steps, spread_min, tol = coef[0], coef[1], coef[2]
+    cal_steps, spread_min, tol, recent_steps = coef[0], coef[1], coef[2], coef[3]
     if cal_steps <= 0.0:
         return m, False
     _accumulate(state[SUMS], m, math.exp(-gap / cal_steps))
     b, radius, distance, raw_radius, raw_distance = _fit(state[SUMS])
+    a = 1.0 - math.exp(-gap / recent_steps)
+    recent_fit = _recent(state, RECENT_FIT, m, b, radius, a)
+    recent_raw = _recent(state, RECENT_RAW, m, b * 0.0, raw_radius, a)
+    fits = radius > 0.0 and distance < tol * radius
+    raw_fits = raw_distance < tol * raw_radius
+    if (fits or raw_fits) and _spread(state[SUMS]) < spread_min * (radius if fits else raw_radius):
+        fits = raw_fits = False  # too few directions to tell a sphere
+    if (fits and recent_fit > tol * tol) or (raw_fits and recent_raw > tol * tol):
+        # the latest samples have left the sphere the window fits: the field has changed, the fit starts afresh
+        _accumulate(state[SUMS], m, 0.0)
+        state[FIT_STEPS] = state[RAW_STEPS] = state[RECENT_FIT] = state[RECENT_RAW] = 0.0
+        return _less_offset(m, state), False
     offset = math.sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2])
+    fits = fits and distance < EXPLAINED * raw_distance and offset > norm_tol * radius
     was_used = state[OFFSET.start] != 0.0 or state[OFFSET.start + 1] != 0.0 or state[OFFSET.start + 2] != 0.0
     changed = False
-    if (radius > 0.0 and distance < tol * radius and distance < EXPLAINED * raw_distance
-            and offset > norm_tol * radius and _spread(state[SUMS]) >= spread_min * radius):
+    if fits:
         state[FIT_STEPS] += gap
         state[RAW_STEPS] = 0.0
         if state[FIT_STEPS] >= steady_steps:
             state[OFFSET] = b
             changed = not was_used
-    elif raw_distance < tol * raw_radius:
+    elif raw_fits:
         state[RAW_STEPS] += gap
         state[FIT_STEPS] = 0.0
         if state[RAW_STEPS] >= steady_steps:
@@ -134,5 +169,10 @@ def hard_iron_step(state, coef, m, gap, norm_tol, steady_steps):
     else:
         state[FIT_STEPS] = 0.0
         state[RAW_STEPS] = 0.0
+    return _less_offset(m, state), changed
+
+
+@kernel(inline=True)
+def _less_offset(m, state):
     b = state[OFFSET]
-    return (m[0] - b[0], m[1] - b[1], m[2] - b[2]), changed
+    return m[0] - b[0], m[1] - b[1], m[2] - b[2]

@@ -159,7 +159,7 @@ def heading_step(state, coef, q, m_sensor):
     ok = False
     n2 = m_sensor[0] * m_sensor[0] + m_sensor[1] * m_sensor[1] + m_sensor[2] * m_sensor[2]
     if math.isfinite(n2) and n2 > 0.0:  # a field sample (not NaN: missing, not all 0: none)
-        m_sensor, proven = hard_iron_step(state[HARD_IRON], coef[8:11], m_sensor, state[GAP], coef[2], coef[5])
+        m_sensor, proven = hard_iron_step(state[HARD_IRON], coef[8:], m_sensor, state[GAP], coef[2], coef[5])
         if proven:  # a field freed of (or back without) an offset: start afresh from it
             state[SEEN] = 0.0
         half = 0.5 * state[0]
