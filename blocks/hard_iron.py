@@ -128,6 +128,13 @@ def _recent(state, index, m, centre, radius, a):
 
 
 @kernel(inline=True)
+def _less_offset(m, state):
+    """The field sample m less the offset in use."""
+    b = state[OFFSET]
+    return m[0] - b[0], m[1] - b[1], m[2] - b[2]
+
+
+@kernel(inline=True)
 def hard_iron_step(state, coef, m, gap, norm_tol, steady_steps):
     """(the field sample m (3-tuple, finite) less the offset estimate after updating it,
     whether the offset was taken or dropped at this sample); state (STATE_SIZE entries) in
@@ -170,9 +177,3 @@ def hard_iron_step(state, coef, m, gap, norm_tol, steady_steps):
         state[FIT_STEPS] = 0.0
         state[RAW_STEPS] = 0.0
     return _less_offset(m, state), changed
-
-
-@kernel(inline=True)
-def _less_offset(m, state):
-    b = state[OFFSET]
-    return m[0] - b[0], m[1] - b[1], m[2] - b[2]

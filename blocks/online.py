@@ -20,6 +20,7 @@ from .jit import kernel
 from .methods import method as get_method, stepper
 from .quaternion import quat_euler_zyx
 from .sensor_frame import SensorFrameStepper, sensor_frame_step, start_gravity
+from .stages import split_params
 
 IO_INPUTS = slice(0, 6)  # gyr x, y, z (rad/s), acc x, y, z (m/s²)
 IO_OUTPUTS = slice(6, 16)  # q w, x, y, z; unit up x, y, z; roll, pitch, yaw (rad)
@@ -83,10 +84,12 @@ class OnlineEstimator:
 
     def __init__(self, method: str = "wiener", params: Mapping[str, float] | None = None, heading: bool = False,
                  gyro_offset: bool = False):
+        params, offset_params, heading_params = split_params(method, params, gyro_offset, heading)
         m = get_method(method)
-        m.runs_kernel(m.resolve(params))  # refuse unknown methods and bad parameters now
+        m.runs_kernel(m.resolve(params))  # refuse bad parameters now
         self.method = method
-        self.params = tuple(sorted((params or {}).items()))
+        self.params = tuple(sorted(params.items()))
+        self._offset_params, self._heading_params = offset_resolve(offset_params), heading_resolve(heading_params)
         self.heading = heading
         self.gyro_offset = gyro_offset
         self.offset = np.zeros((2, 3))  # offset estimate (rad/s) and its variance ((rad/s)²)
@@ -126,9 +129,9 @@ class OnlineEstimator:
                 raise ValueError(f"sample time must be a finite positive number of seconds, got {Ts!r}")
             self._stepper, self._Ts = stepper(self.method, self.params, Ts), Ts
             self.sensor_frame = isinstance(self._stepper, SensorFrameStepper)
-            self._heading_coef = heading_coefficients(heading_resolve(), Ts)
+            self._heading_coef = heading_coefficients(self._heading_params, Ts)
             if self.gyro_offset:
-                self._offset_coef = offset_coefficients(offset_resolve(), Ts)
+                self._offset_coef = offset_coefficients(self._offset_params, Ts)
 
         starting = self.state is None
         if starting:

@@ -1,10 +1,13 @@
 """AttitudeEstimator.fmu: the project's attitude estimators as an FMI 2.0 co-simulation FMU.
 
 Each doStep(t, h) takes gyr (mean rate over (t, t+h]) and acc, mag at t+h, and steps the
-same compiled block as `attitude estimate` (blocks.online.OnlineEstimator). A parameter
-at its start value means "the method's default": the start value is 0, or the default
-itself for a parameter that 0 sets to something (scale_error 0: no scale term, k_I 0: no
-bias estimate). Parameters a method does not have must stay at their start values.
+same compiled block as `attitude estimate` (blocks.online.OnlineEstimator). The tuning
+parameters are those of every method and of the gyro-offset and heading estimators
+(blocks.stages). A parameter at its start value means "the default": the start value is
+0, or the default itself for a parameter that 0 sets to something (scale_error 0: no
+scale term, k_I 0: no bias estimate, tau_motion 0: no offset tracking while moving,
+mag_cal_time 0: no hard-iron fit, mag_new_angle 0: no turn needed). Parameters of a
+method or estimator that does not run must stay at their start values.
 """
 from __future__ import annotations
 
@@ -14,19 +17,20 @@ from fmu_support import IN, OUT, PAR, Fmi2Status, ProjectSlave, fmi_unit
 
 from blocks.methods import METHODS
 from blocks.online import OnlineEstimator
-
+from blocks.stages import ESTIMATORS
 
 
 def tuning_parameters():
-    """Every method's tuning parameters, once each: name → (FMI unit, description, start
-    value meaning the method's default; see the module docstring)."""
+    """Every method's tuning parameters and those of the gyro-offset and heading
+    estimators, once each: name → (FMI unit, description, start value meaning the
+    default; see the module docstring)."""
     params = {}
-    for m in METHODS.values():
-        for p in m.params:
+    for stage in (*(m.params for m in METHODS.values()), *ESTIMATORS.values()):
+        for p in stage:
             start = p.default if p.allow_zero and p.default else 0.0
-            doc = f"{p.doc}; default {start:g}" if start else f"{p.doc}; 0: the method's default"
+            doc = f"{p.doc}; default {start:g}" if start else f"{p.doc}; 0: the default"
             if params.setdefault(p.name, (fmi_unit(p.unit), doc, start))[2] != start:
-                raise ValueError(f"parameter {p.name} needs one start value in every method")
+                raise ValueError(f"parameter {p.name} needs one start value in every stage")
     return params
 
 

@@ -11,6 +11,7 @@ from scipy.spatial.transform import Rotation
 
 from blocks.gyro_offset import correct as correct_gyro
 from blocks.heading import with_magnetometer
+from blocks.stages import split_params
 from blocks.methods import METHODS, KernelStepper, method as get_method, stepper
 from blocks.sensor_frame import start_gravity, time_reversed
 
@@ -60,8 +61,9 @@ def estimate(
 ) -> AttitudeEstimate:
     """Estimate attitude over a recording: gyr N×3 rad/s, acc N×3 m/s², fs in Hz.
 
-    params are the method's documented parameters (see blocks.methods), defaults
-    otherwise. The filter starts at rest on initial_gravity (m/s², sensor coordinates,
+    params are the documented parameters of the method (blocks.methods), of the
+    gyro-offset estimator when it runs and of the heading estimator when mag is given
+    (blocks.stages.split_params), defaults otherwise. The filter starts at rest on initial_gravity (m/s², sensor coordinates,
     before the first sample), by default the first accelerometer sample turned back by
     the first gyro sample (blocks.sensor_frame.start_gravity). offline: the method's earth-frame filter
     forward, then backward over the forward estimate (for `wiener` the non-causal Wiener
@@ -73,16 +75,17 @@ def estimate(
     heading is the gyro's (6D).
     """
     gyr, acc = check_imu(gyr, acc, fs)
+    params, offset_params, heading_params = split_params(method, params, gyro_offset, mag is not None)
     offset = None
     if gyro_offset:
-        gyr, offset = correct_gyro(gyr, acc, fs, offline=offline)
-    step = stepper(method, tuple(sorted((params or {}).items())), 1.0 / fs)
+        gyr, offset = correct_gyro(gyr, acc, fs, offset_params, offline=offline)
+    step = stepper(method, tuple(sorted(params.items())), 1.0 / fs)
     if initial_gravity is None:
         initial_gravity = start_gravity(gyr[0], acc[0], 1.0 / fs)
     if not offline:
         forward = _run(step, gyr, acc, initial_gravity)
         forward.offset = offset
-        return _with_heading(forward, mag, fs)
+        return _with_heading(forward, mag, fs, heading_params)
     if not get_method(method).is_sensor_frame:
         raise ValueError(f"offline smoothing needs an earth-frame filter method "
                          f"({', '.join(n for n, m in METHODS.items() if m.is_sensor_frame)}), not {method!r}")
@@ -98,7 +101,7 @@ def estimate(
         forward = _run(step, gyr, acc, initial_gravity)
         backward = _run(step, gyr_back, np.ascontiguousarray(forward.gravity[::-1]), forward.gravity[-1]).gravity
     gravity = backward[::-1].copy()
-    return _with_heading(AttitudeEstimate(gravity, level_onto(forward.quat, gravity), offset), mag, fs)
+    return _with_heading(AttitudeEstimate(gravity, level_onto(forward.quat, gravity), offset), mag, fs, heading_params)
 
 
 def _run_local(step, gyr, acc, initial_gravity, omega=None):
@@ -112,7 +115,7 @@ def _run_local(step, gyr, acc, initial_gravity, omega=None):
     return (gravity, quat), used
 
 
-def _with_heading(est: AttitudeEstimate, mag, fs: float) -> AttitudeEstimate:
+def _with_heading(est: AttitudeEstimate, mag, fs: float, params) -> AttitudeEstimate:
     if mag is None:
         return est
     mag = np.asarray(mag, dtype=float)
@@ -123,7 +126,7 @@ def _with_heading(est: AttitudeEstimate, mag, fs: float) -> AttitudeEstimate:
         raise ValueError(f"mag has {infinite} infinite values (NaN marks a missing sample)")
     if np.isnan(mag).any(axis=1).all():
         raise ValueError("mag has no sample without NaN: estimate without it (--heading gyro, or mag=None)")
-    est.quat, est.mag_accepted, est.mag_offset = with_magnetometer(est.quat, mag, fs)
+    est.quat, est.mag_accepted, est.mag_offset = with_magnetometer(est.quat, mag, fs, params)
     return est
 
 

@@ -11,6 +11,7 @@ from blocks.heading import initial_state as heading_initial_state
 from blocks.methods import estimator_system, stepper
 from blocks.quaternion import quat_rotate
 from blocks.sensor_frame import GRAVITY_OUTPUTS, QUAT_NAMES
+from blocks.stages import split_params
 
 from .errors import inclination_error
 from .motion import AXES, EARTH_FIELD_UT, HumanMotion
@@ -45,6 +46,7 @@ def magnetometer_system(fs: float, name: str = "magnetometer"):
 def closed_loop(motion: HumanMotion, imu: ImuModel, fs: float, method: str = "wiener",
                 params: dict | None = None, offset: bool = False, heading: bool = False):
     """The diagram and its initial state (estimator at rest on g·ẑ, motion level at rest).
+    params: as blocks.stages.split_params, for the method and the stages below.
 
     offset: the gyro-offset estimator (blocks.gyro_offset, its low-passes at rest on g·ẑ)
     between sensor and estimator; heading: the heading stage (blocks.heading) on the
@@ -53,18 +55,19 @@ def closed_loop(motion: HumanMotion, imu: ImuModel, fs: float, method: str = "wi
     offset_* (rad/s), with heading qh_* and the hard-iron estimate mag_offset_* (µT).
     """
     dt = 1.0 / fs
+    params, offset_params, heading_params = split_params(method, params, offset, heading)
     sensor = imu.system(fs)
     estimator = [estimator_system(method, params, dt)]
     states = [motion.initial_state()]
     if offset:
         sensor.update_names(outputs=[f"{s}_{a}" for s in ("gyr_raw", "acc") for a in AXES])
-        estimator.insert(0, gyro_offset.offset_system(dt))
-        states.append(gyro_offset.initial_state(gyro_offset.coefficients(gyro_offset.resolve(), dt),
+        estimator.insert(0, gyro_offset.offset_system(dt, offset_params))
+        states.append(gyro_offset.initial_state(gyro_offset.coefficients(gyro_offset.resolve(offset_params), dt),
                                                 np.zeros(3), np.array([0.0, 0.0, motion.g])))
-    states.append(stepper(method, tuple(sorted((params or {}).items())), dt).initial_state([0.0, 0.0, motion.g]))
+    states.append(stepper(method, tuple(sorted(params.items())), dt).initial_state([0.0, 0.0, motion.g]))
     outputs = ["incl_err"] + GRAVITY_OUTPUTS + QUAT_NAMES + ([f"offset_{a}" for a in AXES] if offset else [])
     if heading:
-        estimator += [magnetometer_system(fs), heading_system(dt)]
+        estimator += [magnetometer_system(fs), heading_system(dt, heading_params)]
         states.append(heading_initial_state())
         outputs += [f"qh_{c}" for c in "wxyz"] + [f"mag_offset_{a}" for a in AXES]
     diagram = control.interconnect([motion.system(fs), sensor, *estimator, attitude_error_system(fs)],

@@ -99,6 +99,7 @@ def _bad_inputs(tmp_path, gyr, acc):
     jitter = dict(cols, t=cols["t"] * (1 + 0.2 * (np.arange(len(gyr)) % 2) / len(gyr)) + (np.arange(len(gyr)) % 3) * 0.004)
     cases["not uniformly sampled"] = (jitter, [])
     cases["unknown parameter"] = (cols, ["--param", "delta_q=1"])
+    cases["unknown parameter 'mag_norm_tol'"] = (cols, ["--param", "mag_norm_tol=0.2"])  # no magnetometer
     cases["finite positive"] = (cols, ["--param", "delta_n=-1"])
     cases["disagrees"] = (cols, ["--fs", "50"])
     return cases

@@ -117,6 +117,21 @@ def test_estimator_fmu_with_gyro_offset_on_equals_the_batch_path(fmu_dir):
     assert with_offset < 1.0 < 2.0 < without
 
 
+def test_estimator_fmu_passes_gyro_offset_and_heading_parameters_on(fmu_dir):
+    """The gyro-offset and heading estimators' parameters are FMU parameters too; delta_n
+    reaches the filter and the gyro-offset estimator alike, as in the batch path."""
+    motion = profile("sine_rotation").motion({"inclination_deg": 20.0}).generate(20.0, FS)
+    gyr, acc = ImuModel(delta_n=math.radians(0.05), gyr_offset=(0.0, 0.0, 0.01)).apply(motion, seed=3)
+    params = {"delta_n": math.radians(0.3), "rest_time": 0.5, "tau_heading": 2.0, "mag_cal_time": 0.0}
+    runner = FmuRunner(fmu_dir / "AttitudeEstimator.fmu", {"gyro_offset": "on", **params},
+                       INPUTS + ["mag_x", "mag_y", "mag_z"], OUTPUTS + ["gyr_offset_x", "gyr_offset_y", "gyr_offset_z"])
+    out, _ = runner.run(np.hstack([gyr, acc, motion.mag]), 1 / FS)
+    runner.close()
+    ref = estimate(gyr, acc, FS, params=params, gyro_offset=True, mag=motion.mag)
+    assert np.abs(out[:, :4] - ref.quat).max() < 1e-9 and np.abs(out[:, 7:10] - ref.offset).max() < 1e-12
+    assert np.abs(out[:, :4] - estimate(gyr, acc, FS, gyro_offset=True, mag=motion.mag).quat).max() > 1e-4
+
+
 def test_reset_then_second_run_is_identical(fmu_dir, recording):
     gyr, acc = recording
     runner = _estimator(fmu_dir, method="first_order")

@@ -87,26 +87,30 @@ def test_closed_loop_diagram_equals_the_batch_pipeline(method):
     assert np.abs(resp.outputs[0] - inclination_error(est.gravity, up)).max() <= 1e-12
 
 
-def test_closed_loop_diagram_with_offset_and_heading_blocks_equals_the_batch_kernels():
+@pytest.mark.parametrize("params", [{}, {"delta_n": math.radians(0.3), "rest_time": 1.0, "tau_heading": 2.0}])
+def test_closed_loop_diagram_with_offset_and_heading_blocks_equals_the_batch_kernels(params):
     """motion → sensor → gyro-offset estimator → wiener → heading stage (fed by an ideal
     magnetometer) as python-control blocks: the same numbers as the batch path's kernels
     run over the sensor's samples (the offset estimator's low-passes at rest on g·ẑ, as
-    the diagram starts it)."""
+    the diagram starts it), with the defaults and with parameters of every stage."""
     motion = HumanMotion()
     imu = ImuModel(delta_n=math.radians(0.1), gyr_offset=(0.01, 0.0, -0.01), acc_noise=0.01)
     fs = 100.0
-    noise, resp = simulate_closed_loop(motion, imu, fs, duration=5.0, seed=3, offset=True, heading=True)
+    noise, resp = simulate_closed_loop(motion, imu, fs, duration=5.0, params=params, seed=3, offset=True, heading=True)
+    noise_density = {k: v for k, v in params.items() if k == "delta_n"}  # the filter's and the offset estimator's
+    offset_params = {**noise_density, **{k: v for k, v in params.items() if k == "rest_time"}}
+    heading_params = {k: v for k, v in params.items() if k == "tau_heading"}
     state = motion.initial_state()
     truth = np.empty((len(noise), 10))
     _human_run(state, np.ascontiguousarray(noise[:, :6]), motion.coefficients(fs), truth)
     gyr, acc = imu.measure(truth[:, 0:3], truth[:, 3:6], noise[:, 6:12], fs)
-    coef = gyro_offset.coefficients(gyro_offset.resolve(), 1.0 / fs)
+    coef = gyro_offset.coefficients(gyro_offset.resolve(offset_params), 1.0 / fs)
     offset, variance = np.empty_like(gyr), np.empty_like(gyr)
     gyro_offset.run(gyro_offset.initial_state(coef, np.zeros(3), np.array([0.0, 0.0, motion.g])), coef,
                     gyr, np.ascontiguousarray(acc), offset, variance)
-    est = estimate(gyr - offset, acc, fs, initial_gravity=[0, 0, motion.g])
+    est = estimate(gyr - offset, acc, fs, params=noise_density, initial_gravity=[0, 0, motion.g])
     mag = Rotation.from_quat(truth[:, 6:10], scalar_first=True).inv().apply(EARTH_FIELD_UT)
-    quat, _, mag_offset = with_magnetometer(est.quat, mag, fs)
+    quat, _, mag_offset = with_magnetometer(est.quat, mag, fs, heading_params)
     out = dict(zip(resp.output_labels, resp.outputs))
     assert np.abs(np.column_stack([out[f"ghat_{c}"] for c in "xyz"]) - est.gravity).max() <= 1e-12
     assert np.abs(np.column_stack([out[f"qh_{c}"] for c in "wxyz"]) - quat).max() <= 1e-12

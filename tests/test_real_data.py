@@ -273,6 +273,22 @@ def _turns_with_field(earth_field=None, rest=None, duration=600.0):
     return motion, gyr, acc, ideal + np.random.default_rng(2).normal(0, 0.5, ideal.shape)
 
 
+def test_parameters_reach_every_running_stage_that_has_them():
+    """params go to the method, the gyro-offset and the heading estimator, to each that
+    runs and has the name: delta_n, the gyro's noise density, to the first two alike. A
+    name no running stage has is refused, with the names they have."""
+    motion, gyr, acc, mag = _turns_with_field(duration=100.0)
+    noise, offset_only, heading_only = {"delta_n": math.radians(0.3)}, {"rest_time": 3.0}, {"tau_heading": 5.0}
+    est = estimate(gyr, acc, FS, params={**noise, **offset_only, **heading_only}, gyro_offset=True, mag=mag)
+    corrected, offset = correct_gyro(gyr, acc, FS, {**noise, **offset_only})
+    quat = with_magnetometer(estimate(corrected, acc, FS, params=noise).quat, mag, FS, heading_only)[0]
+    assert np.array_equal(est.offset, offset) and np.array_equal(est.quat, quat)
+    assert np.abs(est.quat - estimate(gyr, acc, FS, gyro_offset=True, mag=mag).quat).max() > 1e-4
+    with pytest.raises(ValueError, match=r"unknown parameter 'tau_heading' \(the method wiener: delta_n.*; "
+                                         r"the gyro-offset estimator: rest_gyr.*\)$"):
+        estimate(gyr, acc, FS, params=heading_only, gyro_offset=True)
+
+
 def test_magnetometer_heading_follows_the_field_and_survives_a_disturbance():
     motion, gyr, acc, mag = _turns_with_field()
     heading_of = lambda est: np.degrees(quaternion_errors(est.quat, motion.quat)[1])
