@@ -150,18 +150,20 @@ def hard_iron_step(state, coef, m, gap, norm_tol, steady_steps):
     recent_raw = _recent(state, RECENT_RAW, m, b * 0.0, raw_radius, a)
     fits = radius > 0.0 and distance < tol * radius
     raw_fits = raw_distance < tol * raw_radius
-    if (fits or raw_fits) and _spread(state[SUMS]) < spread_min * (radius if fits else raw_radius):
-        fits = raw_fits = False  # too few directions to tell a sphere
-    if (fits and recent_fit > tol * tol) or (raw_fits and recent_raw > tol * tol):
+    left = (fits and recent_fit > tol * tol) or (raw_fits and recent_raw > tol * tol)
+    offset = math.sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2])
+    explained = fits and distance < EXPLAINED * raw_distance and offset > norm_tol * radius
+    was_used = state[OFFSET.start] != 0.0 or state[OFFSET.start + 1] != 0.0 or state[OFFSET.start + 2] != 0.0
+    raw_fits = raw_fits and was_used  # only an offset in use can be dropped
+    if (left or explained or raw_fits) and _spread(state[SUMS]) < spread_min * (radius if fits else raw_radius):
+        left = explained = raw_fits = False  # too few directions to tell a sphere
+    if left:
         # the latest samples have left the sphere the window fits: the field has changed, the fit starts afresh
         _accumulate(state[SUMS], m, 0.0)
         state[FIT_STEPS] = state[RAW_STEPS] = state[RECENT_FIT] = state[RECENT_RAW] = 0.0
         return _less_offset(m, state), False
-    offset = math.sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2])
-    fits = fits and distance < EXPLAINED * raw_distance and offset > norm_tol * radius
-    was_used = state[OFFSET.start] != 0.0 or state[OFFSET.start + 1] != 0.0 or state[OFFSET.start + 2] != 0.0
     changed = False
-    if fits:
+    if explained:
         state[FIT_STEPS] += gap
         state[RAW_STEPS] = 0.0
         if state[FIT_STEPS] >= steady_steps:
