@@ -9,6 +9,7 @@ from scipy.spatial.transform import Rotation
 
 from blocks import accuracy
 from blocks.methods import design_delta_v, method as get_method
+from blocks.stages import split_params
 
 from .batch import estimate
 from .errors import quaternion_errors
@@ -48,7 +49,7 @@ def plot_recording(path, out, method: str = "wiener", params=None, offline: bool
     bottom.loglog(f[1:], psd[1:].mean(axis=1), label="measured, horizontal components")
     m = get_method(method)
     if m.is_sensor_frame and method == "wiener" and not offline:
-        p = m.resolve(params)
+        p = m.resolve(split_params(method, params, gyro_offset, False)[0])
         g = p["g"]
         # one-sided per Hz: 2·S(2πf); divided by g² for a tilt in rad
         delta_v = design_delta_v(p)

@@ -464,7 +464,8 @@ def test_plot_writes_a_png_and_refuses_a_recording_without_reference(tmp_path, c
         0.8 * np.sin(0.5 * t), 0.5 * np.sin(0.3 * t)])), lambda t: np.zeros((len(t), 3))).generate(60.0, FS)
     _broad_like(tmp_path / "a.mat", motion)
     out = tmp_path / "a.png"
-    assert main(["plot", str(tmp_path / "a.mat"), "--method", "wiener", "--out", str(out)]) == 0
+    assert main(["plot", str(tmp_path / "a.mat"), "--method", "wiener", "--out", str(out),
+                 "--param", "delta_v=2", "--param", "rest_time=3"]) == 0  # the filter's and the offset estimator's
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     _broad_like(tmp_path / "b.mat", motion, quat_ref=False)
     assert main(["plot", str(tmp_path / "b.mat"), "--out", str(tmp_path / "b.png")]) == 2
