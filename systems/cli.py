@@ -5,6 +5,7 @@ import argparse
 import json
 import os
 import sys
+import time
 
 import numpy as np
 
@@ -122,11 +123,21 @@ def cmd_estimate(args) -> int:
     from .batch import estimate
     from .recording import read_recording, write_estimate
 
+    clock = time.perf_counter()
+
+    def progress(text):  # each stage takes about 3 s per million samples
+        nonlocal clock
+        now = time.perf_counter()
+        print(f"attitude: {text} ({now - clock:.1f} s)", file=sys.stderr, flush=True)
+        clock = now
+
     rec = read_recording(args.input, fs=args.fs, gyr_unit=args.gyr_unit, acc_unit=args.acc_unit)
+    progress(f"read {len(rec.gyr)} samples at {rec.fs:g} Hz from {args.input}")
     result = estimate(rec.gyr, rec.acc, rec.fs, args.method, dict(args.param), offline=args.offline,
                       gyro_offset=args.gyro_offset == "on", mag=rec.mag if args.heading == "mag" else None)
+    progress(f"estimated with {args.method}{' --offline' if args.offline else ''}")
     write_estimate(args.out, rec.t, result.quat, result.up)
-    print(f"attitude: {len(rec.gyr)} samples at {rec.fs:g} Hz, method {args.method} → {args.out}", file=sys.stderr)
+    progress(f"wrote {args.out}")
     if result.offset is not None:
         print("attitude: gyro offset estimate at the end "
               f"({', '.join(f'{v:.3f}' for v in np.degrees(result.offset[-1]))}) °/s", file=sys.stderr)

@@ -43,11 +43,15 @@ def _read_output(path):
     return header, np.loadtxt(path, delimiter=",", skiprows=1)
 
 
-def test_estimate_csv_writes_the_contracted_columns_equal_to_the_batch_path(tmp_path, imu):
+def test_estimate_csv_writes_the_contracted_columns_equal_to_the_batch_path(tmp_path, imu, capsys):
     gyr, acc = imu
     _write_csv(tmp_path / "in.csv", _imu_columns(gyr, acc))
     assert main(["estimate", str(tmp_path / "in.csv"), "--out", str(tmp_path / "out.csv"),
                  "--param", "delta_n=0.001", "--param", "delta_v=1.5"]) == 0
+    progress = [line for line in capsys.readouterr().err.splitlines() if line.endswith(" s)")]
+    assert [line.split(" (")[0] for line in progress] == [
+        f"attitude: read {len(gyr)} samples at {FS:g} Hz from {tmp_path / 'in.csv'}",
+        "attitude: estimated with wiener", f"attitude: wrote {tmp_path / 'out.csv'}"]
     header, data = _read_output(tmp_path / "out.csv")
     assert header == list(OUTPUT_COLUMNS)
     ref = estimate(gyr, acc, FS, "wiener", {"delta_n": 0.001, "delta_v": 1.5}, gyro_offset=True)  # CLI defaults
