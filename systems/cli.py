@@ -13,6 +13,8 @@ from blocks.methods import METHODS
 from blocks.methods import method as known_method
 from blocks.stages import ESTIMATORS
 
+from .recording import MAG_UNITS
+
 EXIT_BAD_INPUT = 2
 EXIT_CHECK_FAILED = 1
 TABLE1_TOLERANCE = 0.07  # simulated cells must lie within ±7 % of eq. 50
@@ -69,6 +71,7 @@ def build_parser() -> argparse.ArgumentParser:
                      help="parameter of the method, the gyro-offset or the heading estimator, in the unit listed below; repeatable")
     est.add_argument("--gyr-unit", default="rad/s", choices=["rad/s", "deg/s"])
     est.add_argument("--acc-unit", default="m/s2", choices=["m/s2", "g"])
+    est.add_argument("--mag-unit", default="uT", choices=list(MAG_UNITS), help="magnetometer unit (default uT)")
     _add_real_data_flags(est)
 
     ev = sub.add_parser("evaluate", help="errors against an optical reference (BROAD .mat), beside vqf and madgwick")
@@ -121,7 +124,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 def cmd_estimate(args) -> int:
     from .batch import estimate
-    from .recording import read_recording, write_estimate
+    from .recording import field_norm_note, read_recording, write_estimate
 
     clock = time.perf_counter()
 
@@ -131,8 +134,12 @@ def cmd_estimate(args) -> int:
         print(f"attitude: {text} ({now - clock:.1f} s)", file=sys.stderr, flush=True)
         clock = now
 
-    rec = read_recording(args.input, fs=args.fs, gyr_unit=args.gyr_unit, acc_unit=args.acc_unit)
+    rec = read_recording(args.input, fs=args.fs, gyr_unit=args.gyr_unit, acc_unit=args.acc_unit,
+                         mag_unit=args.mag_unit)
     progress(f"read {len(rec.gyr)} samples at {rec.fs:g} Hz from {args.input}")
+    note = field_norm_note(rec) if args.heading == "mag" else None
+    if note:
+        print(f"attitude: note: {note}", file=sys.stderr)
     result = estimate(rec.gyr, rec.acc, rec.fs, args.method, dict(args.param), offline=args.offline,
                       gyro_offset=args.gyro_offset == "on", mag=rec.mag if args.heading == "mag" else None)
     progress(f"estimated with {args.method}{' --offline' if args.offline else ''}")

@@ -15,6 +15,8 @@ MAG_COLUMNS = ("mag_x", "mag_y", "mag_z")
 OUTPUT_COLUMNS = ("t", "q_w", "q_x", "q_y", "q_z", "g_x", "g_y", "g_z")
 GYR_UNITS = {"rad/s": 1.0, "deg/s": math.pi / 180.0}
 ACC_UNITS = {"m/s2": 1.0, "g": STANDARD_GRAVITY}
+MAG_UNITS = {"uT": 1.0, "nT": 1e-3, "G": 100.0, "mG": 0.1}  # to µT
+EARTH_FIELD_RANGE_UT = (20.0, 70.0)  # the geomagnetic field's norm anywhere on earth, about 22–67 µT
 MAX_GYRO_RAD_S = 40.0  # beyond the ±2000 °/s range of MEMS gyros: such values are not rad/s
 
 
@@ -54,20 +56,43 @@ class Recording:
                        quat_ref=cut(self.quat_ref), movement=cut(self.movement))
 
 
-def read_recording(path, fs: float | None = None, gyr_unit: str = "rad/s", acc_unit: str = "m/s2") -> Recording:
-    """Read a CSV (header t,gyr_x..z,acc_x..z[,mag_x..z]; t may be replaced by fs) or a BROAD .mat."""
+def read_recording(path, fs: float | None = None, gyr_unit: str = "rad/s", acc_unit: str = "m/s2",
+                   mag_unit: str = "uT") -> Recording:
+    """Read a CSV (header t,gyr_x..z,acc_x..z[,mag_x..z]; t may be replaced by fs) or a BROAD
+    .mat, in the units given (GYR_UNITS, ACC_UNITS, MAG_UNITS), into rad/s, m/s² and µT."""
     path = Path(path)
     if not path.is_file():
         raise RecordingError(f"{path}: no such file")
-    if gyr_unit not in GYR_UNITS or acc_unit not in ACC_UNITS:
-        raise RecordingError(f"units must be one of {list(GYR_UNITS)} and {list(ACC_UNITS)}")
+    if gyr_unit not in GYR_UNITS or acc_unit not in ACC_UNITS or mag_unit not in MAG_UNITS:
+        raise RecordingError(f"units must be one of {list(GYR_UNITS)}, {list(ACC_UNITS)} and {list(MAG_UNITS)}")
     rec = _read_mat(path) if path.suffix.lower() == ".mat" else _read_csv(path, fs)
     if fs is not None and abs(rec.fs - fs) > 0.01 * fs:
         raise RecordingError(f"{path}: --fs {fs:g} Hz disagrees with the recording's {rec.fs:g} Hz")
     rec.gyr = rec.gyr * GYR_UNITS[gyr_unit]
     rec.acc = rec.acc * ACC_UNITS[acc_unit]
+    if rec.mag is not None:
+        rec.mag = rec.mag * MAG_UNITS[mag_unit]
     _check_values(rec)
     return rec
+
+
+def field_norm_note(rec: Recording) -> str | None:
+    """A note when the magnetometer's median norm (µT after the unit conversion) is far
+    from the earth's field: a unit not given, or a sensor that reports raw counts. The
+    heading and hard-iron estimators use directions and relative norms only, so they work
+    in any unit; only the hard-iron offset is then reported in the input's unit."""
+    if rec.mag is None:
+        return None
+    rows = rec.mag[np.isfinite(rec.mag).all(axis=1)]
+    if not len(rows):
+        return None
+    norm = float(np.median(np.linalg.norm(rows, axis=1)))
+    low, high = EARTH_FIELD_RANGE_UT
+    if low / 2 <= norm <= 2 * high:
+        return None
+    return (f"{rec.name}: the magnetometer's median norm is {norm:.3g} µT, far from the earth's "
+            f"{low:g}–{high:g} µT; if it is not in µT pass --mag-unit ({', '.join(MAG_UNITS)}). The heading "
+            "works in any unit; the hard-iron offset is reported in the input's")
 
 
 def _read_csv(path: Path, fs: float | None) -> Recording:

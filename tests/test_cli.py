@@ -72,6 +72,27 @@ def test_estimate_without_t_column_needs_fs_and_honours_units(tmp_path, imu):
     assert np.abs(_read_output(out)[1][:, 1:5] - ref.quat).max() < 1e-8
 
 
+def test_estimate_takes_the_magnetometer_unit_and_notes_a_norm_far_from_the_earths(tmp_path, imu, capsys):
+    """--mag-unit G converts to µT: the estimate and the reported hard-iron offset are those
+    of the field in µT. Without it the field in G (norm 0.5) is noted as far from the
+    earth's (49.2 µT read as 0.492); the heading, which uses directions and relative norms
+    only, is the same."""
+    gyr, acc = imu
+    field = HumanMotion(delta_v=0.1, omega_c=5.0).generate(30.0, FS, seed=11).mag  # the imu fixture's motion
+    outputs, notes = [], []
+    for unit, scale in (("uT", 1.0), ("G", 0.01), (None, 0.01)):
+        _write_csv(tmp_path / "in.csv", {**_imu_columns(gyr, acc), **{f"mag_{a}": scale * field[:, i]
+                                                                      for i, a in enumerate("xyz")}})
+        flags = ["--mag-unit", unit] if unit else []
+        assert main(["estimate", str(tmp_path / "in.csv"), "--out", str(tmp_path / "out.csv"), *flags]) == 0
+        outputs.append(_read_output(tmp_path / "out.csv")[1])
+        err = capsys.readouterr().err
+        notes.append("note: in: the magnetometer's median norm is 0.492 µT" in err and "--mag-unit" in err)
+    assert notes == [False, False, True]
+    assert np.abs(outputs[1] - outputs[0]).max() < 1e-9 and np.abs(outputs[2] - outputs[0]).max() < 1e-9
+    assert np.abs(outputs[0][:, 1:5] - estimate(gyr, acc, FS, gyro_offset=True, mag=field).quat).max() < 1e-9
+
+
 def test_estimate_reads_a_broad_mat_recording(tmp_path, imu, capsys):
     gyr, acc = imu
     mag = np.tile([0.0, 20.0, -45.0], (len(gyr), 1))
