@@ -34,8 +34,8 @@ def _param(text: str) -> tuple[str, float]:
 def _method_help() -> str:
     lines = []
     stages = [(f"{m.name}: {m.summary}", m.params) for m in METHODS.values()]
-    runs_with = {"the gyro-offset estimator": "--gyro-offset on", "the heading estimator": "--heading mag and a magnetometer"}
-    stages += [(f"{name} ({runs_with[name]}):", ps) for name, ps in ESTIMATORS.items()]
+    runs_with = ("--gyro-offset on", "--heading mag and a magnetometer")  # in the order of ESTIMATORS
+    stages += [(f"{name} ({when}):", ps) for (name, ps), when in zip(ESTIMATORS.items(), runs_with)]
     for title, params in stages:
         lines.append(title)
         for p in params:
@@ -61,14 +61,16 @@ def build_parser() -> argparse.ArgumentParser:
 
     est = sub.add_parser(
         "estimate", help="estimate attitude over a recording",
-        formatter_class=argparse.RawDescriptionHelpFormatter, epilog="methods and estimators, and their parameters (a name under several sets it in each):\n" + _method_help(),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        epilog="methods and estimators, and their parameters (a name under several sets it in each):\n" + _method_help(),
     )
     est.add_argument("input", help="CSV (t,gyr_x,gyr_y,gyr_z,acc_x,acc_y,acc_z[,mag_x,mag_y,mag_z]) or BROAD .mat")
     est.add_argument("--out", required=True, help="output CSV: t,q_w,q_x,q_y,q_z,g_x,g_y,g_z")
     est.add_argument("--method", default="wiener", choices=sorted(METHODS))
     est.add_argument("--fs", type=float, help="sample rate in Hz (required when the CSV has no t column)")
     est.add_argument("--param", type=_param, action="append", default=[], metavar="NAME=VALUE",
-                     help="parameter of the method, the gyro-offset or the heading estimator, in the unit listed below; repeatable")
+                     help="parameter of the method, the gyro-offset or the heading estimator, in the unit listed "
+                          "below; repeatable")
     est.add_argument("--gyr-unit", default="rad/s", choices=["rad/s", "deg/s"])
     est.add_argument("--acc-unit", default="m/s2", choices=["m/s2", "g"])
     est.add_argument("--mag-unit", default="uT", choices=list(MAG_UNITS), help="magnetometer unit (default uT)")

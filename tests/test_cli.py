@@ -176,3 +176,13 @@ def test_estimate_runs_every_method_as_the_batch_path_does(tmp_path, imu, method
     assert main(["estimate", str(tmp_path / "in.csv"), "--out", str(tmp_path / "out.csv"), "--method", method]) == 0
     ref = estimate(gyr, acc, FS, method, gyro_offset=True)
     assert np.abs(_read_output(tmp_path / "out.csv")[1][:, 1:5] - ref.quat).max() < 1e-9
+
+
+def test_estimate_help_lists_every_stage_with_its_parameters(capsys):
+    with pytest.raises(SystemExit):
+        main(["estimate", "--help"])
+    text = capsys.readouterr().out
+    for title, line in (("wiener:", "scale_error [1] (default 0.005)"),
+                        ("the gyro-offset estimator (--gyro-offset on):", "rest_time [s] (default 1.5)"),
+                        ("the heading estimator (--heading mag and a magnetometer):", "mag_cal_recent [s] (default 2)")):
+        assert title in text and f"    {line}: " in text.split(title, 1)[1]
