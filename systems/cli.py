@@ -93,6 +93,8 @@ def build_parser() -> argparse.ArgumentParser:
     pl.add_argument("--param", type=_param, action="append", default=[], metavar="NAME=VALUE")
     pl.add_argument("--offline", action="store_true")
     pl.add_argument("--gyro-offset", default="on", choices=["on", "off"])
+    pl.add_argument("--heading", default="mag", choices=["mag", "gyro"],
+                    help="with a magnetometer in the recording, also the heading error (default), or not")
 
     t1 = sub.add_parser("table1", help="Rizun's Table 1: analytic (eq. 50) and simulated RMS attitude error")
     t1.add_argument("--json", action="store_true", help="print JSON instead of a table")
@@ -185,8 +187,10 @@ def cmd_plot(args) -> int:
     from .plot import plot_recording
 
     result = plot_recording(args.file, args.out, args.method, dict(args.param), args.offline,
-                            args.gyro_offset == "on")
-    print(f"attitude: wrote {args.out} (inclination RMSE {result['inclination_rmse_deg']:.2f}°)", file=sys.stderr)
+                            args.gyro_offset == "on", args.heading == "mag")
+    heading = f", heading RMSE {result['heading_rmse_deg']:.2f}°" if "heading_rmse_deg" in result else ""
+    print(f"attitude: wrote {args.out} (inclination RMSE {result['inclination_rmse_deg']:.2f}°{heading})",
+          file=sys.stderr)
     return 0
 
 

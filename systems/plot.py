@@ -17,9 +17,13 @@ from .recording import RecordingError, read_recording
 
 
 def plot_recording(path, out, method: str = "wiener", params=None, offline: bool = False,
-                   gyro_offset: bool = True) -> dict:
-    """Draw the error of method on a recording with a reference into out (PNG); returns
-    the inclination RMSE (deg) over the movement phase."""
+                   gyro_offset: bool = True, heading: bool = True) -> dict:
+    """Draw the error of method on a recording with a reference into out (PNG): the
+    inclination error over time, with heading (and a magnetometer in the recording) the
+    heading error with the samples the disturbance guard refused shaded and the times a
+    hard-iron offset was taken or dropped marked, and the tilt error's spectrum beside eq. 42.
+    Returns the inclination and (with the magnetometer) heading RMSE (deg) over the
+    movement phase."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -31,21 +35,26 @@ def plot_recording(path, out, method: str = "wiener", params=None, offline: bool
     valid = rec.movement & np.isfinite(rec.quat_ref).all(axis=1)
     if valid.sum() < 16:
         raise RecordingError(f"{rec.name}: too few valid reference samples during movement")
-    est = estimate(rec.gyr, rec.acc, rec.fs, method, params, offline=offline, gyro_offset=gyro_offset)
-    inclination = np.full(len(rec.gyr), np.nan)
-    inclination[valid] = np.degrees(quaternion_errors(est.quat[valid], rec.quat_ref[valid])[2])
+    mag = rec.mag if heading else None
+    est = estimate(rec.gyr, rec.acc, rec.fs, method, params, offline=offline, gyro_offset=gyro_offset, mag=mag)
+    inclination, heading_error = np.full(len(rec.gyr), np.nan), np.full(len(rec.gyr), np.nan)
+    _, heading_error[valid], inclination[valid] = np.degrees(quaternion_errors(est.quat[valid], rec.quat_ref[valid]))
     # horizontal earth-frame components of the estimated up: small-angle tilt errors, rad
     up = est.gravity / np.linalg.norm(est.gravity, axis=1, keepdims=True)
     tilt = Rotation.from_quat(rec.quat_ref[valid], scalar_first=True).apply(up[valid])[:, :2]
     f, psd = signal.welch(tilt, fs=rec.fs, nperseg=min(len(tilt), int(60 * rec.fs)), axis=0)
-    fig, (top, bottom) = plt.subplots(2, 1, figsize=(8, 7))
+    fig, axes = plt.subplots(2 if mag is None else 3, 1, figsize=(8, 7 if mag is None else 10))
+    top, bottom = axes[0], axes[-1]
     t = np.arange(1, len(rec.gyr) + 1) / rec.fs
     top.plot(t, inclination, lw=0.7)
     top.set_xlabel("time, s")
     top.set_ylabel("inclination error, °")
-    rmse = math.sqrt(float(np.nanmean(inclination**2)))
+    rmse = {"inclination_rmse_deg": math.sqrt(float(np.nanmean(inclination**2)))}
     label = f"{method}{' --offline' if offline else ''}"
-    top.set_title(f"{rec.name}: {label}, RMSE {rmse:.2f}° over the movement phase")
+    top.set_title(f"{rec.name}: {label}, RMSE {rmse['inclination_rmse_deg']:.2f}° over the movement phase")
+    if mag is not None:
+        rmse["heading_rmse_deg"] = math.sqrt(float(np.nanmean(heading_error**2)))
+        _heading_panel(axes[1], t, heading_error, est, rmse["heading_rmse_deg"])
     bottom.loglog(f[1:], psd[1:].mean(axis=1), label="measured, horizontal components")
     m = get_method(method)
     if m.is_sensor_frame and method == "wiener" and not offline:
@@ -63,4 +72,20 @@ def plot_recording(path, out, method: str = "wiener", params=None, offline: bool
     fig.tight_layout()
     fig.savefig(out, dpi=110)
     plt.close(fig)
-    return {"inclination_rmse_deg": rmse}
+    return rmse
+
+
+def _heading_panel(ax, t, heading_error, est, rmse) -> None:
+    """Heading error over time; shaded where the guard refused the field, lines where the
+    hard-iron offset changed."""
+    ax.plot(t, heading_error, lw=0.7, color="C1")
+    refused = ~est.mag_accepted
+    ax.fill_between(t, 0, 1, where=refused, transform=ax.get_xaxis_transform(), color="0.85", step="mid",
+                    label=f"field refused ({100 * refused.mean():.0f} % of samples)")
+    used = np.any(est.mag_offset != 0, axis=1)
+    for i, k in enumerate(np.flatnonzero(used[1:] != used[:-1])):
+        ax.axvline(t[k + 1], color="C3", lw=1.0, label=None if i else "hard-iron offset taken or dropped")
+    ax.set_xlabel("time, s")
+    ax.set_ylabel("heading error, °")
+    ax.set_title(f"heading from the magnetometer, RMSE {rmse:.2f}°")
+    ax.legend(loc="upper right")

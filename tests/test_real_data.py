@@ -467,6 +467,12 @@ def test_plot_writes_a_png_and_refuses_a_recording_without_reference(tmp_path, c
     assert main(["plot", str(tmp_path / "a.mat"), "--method", "wiener", "--out", str(out),
                  "--param", "delta_v=2", "--param", "rest_time=3"]) == 0  # the filter's and the offset estimator's
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    # with the recording's magnetometer the heading error too, as attitude evaluate measures it
+    errors = evaluate_recording(read_recording(tmp_path / "a.mat"), params={"delta_v": 2.0, "rest_time": 3.0})["wiener"]
+    assert (f"inclination RMSE {errors['inclination_rmse_deg']:.2f}°, "
+            f"heading RMSE {errors['heading_rmse_deg']:.2f}°") in capsys.readouterr().err
+    assert main(["plot", str(tmp_path / "a.mat"), "--out", str(out), "--heading", "gyro"]) == 0
+    assert "heading RMSE" not in capsys.readouterr().err
     _broad_like(tmp_path / "b.mat", motion, quat_ref=False)
     assert main(["plot", str(tmp_path / "b.mat"), "--out", str(tmp_path / "b.png")]) == 2
     assert "no optical reference" in capsys.readouterr().err
