@@ -23,10 +23,12 @@ b is taken or dropped, the field it leaves is proven homogeneous, and the headin
 starts afresh from it.
 
 The field can change for good within the window (a magnet put on or taken off): once
-the window, covering every direction, fits a sphere (about b or about 0) but the latest
-samples (mean square distance low-passed over mag_cal_recent) lie more than mag_cal_tol
-off it, the sums start afresh from the latest sample, so that the fit proves the new
-field within about a minute instead of mixing it with the old one for several.
+the window, at least mag_new_time old and covering every direction, fits a sphere (about
+b or about 0) but the latest samples (mean square distance low-passed over
+mag_cal_recent) lie more than mag_cal_tol off it, the sums start afresh from the latest
+sample, so that the fit proves the new field within about a minute instead of mixing it
+with the old one for several. (A younger window's fit is not yet sure enough to be left:
+its error where the sensor turns next alone exceeds the tolerance.)
 Soft iron (a scaled, skewed sphere) is not modelled. mag_cal_time = 0 switches the
 estimate off.
 """
@@ -54,8 +56,9 @@ STATE_NAMES = (
     "b_x", "b_y", "b_z",  # the offset in use
     "fit_steps", "raw_steps",  # steps the fit, or the field as it is, has held steady
     "recent_fit", "recent_raw",  # the latest samples' mean square distance from either sphere, relative to its radius
+    "age",  # steps since the sums started afresh
 )
-SUMS, OFFSET, FIT_STEPS, RAW_STEPS, RECENT_FIT, RECENT_RAW = slice(0, 15), slice(15, 18), 18, 19, 20, 21
+SUMS, OFFSET, FIT_STEPS, RAW_STEPS, RECENT_FIT, RECENT_RAW, AGE = slice(0, 15), slice(15, 18), 18, 19, 20, 21, 22
 STATE_SIZE = len(STATE_NAMES)
 
 
@@ -144,13 +147,14 @@ def hard_iron_step(state, coef, m, gap, norm_tol, steady_steps):
     if cal_steps <= 0.0:
         return m, False
     _accumulate(state[SUMS], m, math.exp(-gap / cal_steps))
+    state[AGE] += gap
     b, radius, distance, raw_radius, raw_distance = _fit(state[SUMS])
     a = 1.0 - math.exp(-gap / recent_steps)
     recent_fit = _recent(state, RECENT_FIT, m, b, radius, a)
     recent_raw = _recent(state, RECENT_RAW, m, b * 0.0, raw_radius, a)
     fits = radius > 0.0 and distance < tol * radius
     raw_fits = raw_distance < tol * raw_radius
-    left = (fits and recent_fit > tol * tol) or (raw_fits and recent_raw > tol * tol)
+    left = state[AGE] >= steady_steps and ((fits and recent_fit > tol * tol) or (raw_fits and recent_raw > tol * tol))
     offset = math.sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2])
     explained = fits and distance < EXPLAINED * raw_distance and offset > norm_tol * radius
     was_used = state[OFFSET.start] != 0.0 or state[OFFSET.start + 1] != 0.0 or state[OFFSET.start + 2] != 0.0
@@ -160,7 +164,7 @@ def hard_iron_step(state, coef, m, gap, norm_tol, steady_steps):
     if left:
         # the latest samples have left the sphere the window fits: the field has changed, the fit starts afresh
         _accumulate(state[SUMS], m, 0.0)
-        state[FIT_STEPS] = state[RAW_STEPS] = state[RECENT_FIT] = state[RECENT_RAW] = 0.0
+        state[FIT_STEPS] = state[RAW_STEPS] = state[RECENT_FIT] = state[RECENT_RAW] = state[AGE] = 0.0
         return _less_offset(m, state), False
     changed = False
     if explained:
