@@ -47,7 +47,7 @@ PARAMS = (
     Param("mag_cal_spread", 0.1, "1", "least s.d. of the field across its smallest axis, relative to the fit's radius"),
     Param("mag_cal_tol", 0.05, "1", "largest rms distance of the field from the fitted sphere, relative to its radius"),
     Param("mag_cal_recent", 2.0, "s", "time constant over which the latest field samples are held against the sphere "
-          "the recent ones fit"),
+          "the window fits; when they leave it, the fit starts afresh"),
 )
 EXPLAINED = 0.5  # the fit's residual must be below this share of the field's own
 STATE_NAMES = (
