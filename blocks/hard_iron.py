@@ -151,7 +151,7 @@ def hard_iron_step(state, coef, m, gap, norm_tol, steady_steps):
     b, radius, distance, raw_radius, raw_distance = _fit(state[SUMS])
     a = 1.0 - math.exp(-gap / recent_steps)
     recent_fit = _recent(state, RECENT_FIT, m, b, radius, a)
-    recent_raw = _recent(state, RECENT_RAW, m, b * 0.0, raw_radius, a)
+    recent_raw = _recent(state, RECENT_RAW, m, (0.0, 0.0, 0.0), raw_radius, a)
     fits = radius > 0.0 and distance < tol * radius
     raw_fits = raw_distance < tol * raw_radius
     left = state[AGE] >= steady_steps and ((fits and recent_fit > tol * tol) or (raw_fits and recent_raw > tol * tol))

@@ -176,8 +176,9 @@ def heading_step(state, coef, q, m_sensor):
 def run(state, coef, quat, mag, out, accepted, offset):
     """Per sample: out (N×4) the orientation with magnetometer heading, accepted (N) whether
     the field passed the guard, offset (N×3) the hard-iron estimate. quat N×4 (sensor →
-    earth), mag N×3 (µT; a row with a NaN is a missing sample, a magnetometer slower than
-    the IMU); state (see initial_state) is carried over from call to call."""
+    earth), mag N×3 (any unit, the offset in the same; a row with a NaN is a missing
+    sample, a magnetometer slower than the IMU); state (see initial_state) is carried over
+    from call to call."""
     for k in range(quat.shape[0]):
         turned, ok = heading_step(state, coef, (quat[k, 0], quat[k, 1], quat[k, 2], quat[k, 3]),
                                   (mag[k, 0], mag[k, 1], mag[k, 2]))
