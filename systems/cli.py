@@ -13,7 +13,7 @@ from blocks.methods import METHODS
 from blocks.methods import method as known_method
 from blocks.stages import ESTIMATORS
 
-from .recording import MAG_UNITS
+from .recording import ACC_UNITS, GYR_UNITS, MAG_UNITS, MAX_GAP_S, MOVEMENT_COLUMN, REF_COLUMNS
 
 EXIT_BAD_INPUT = 2
 EXIT_CHECK_FAILED = 1
@@ -53,6 +53,21 @@ def _add_real_data_flags(parser) -> None:
                         help="heading from the magnetometer when the input has one (default), or the gyro's (6D)")
 
 
+def _add_input_flags(parser) -> None:
+    parser.add_argument("--fs", type=float, help="sample rate in Hz (required when a CSV has no t column)")
+    parser.add_argument("--gyr-unit", default="rad/s", choices=list(GYR_UNITS))
+    parser.add_argument("--acc-unit", default="m/s2", choices=list(ACC_UNITS))
+    parser.add_argument("--mag-unit", default="uT", choices=list(MAG_UNITS), help="magnetometer unit (default uT)")
+    parser.add_argument("--max-gap", type=float, default=MAX_GAP_S, metavar="S",
+                        help="longest run of samples missing from a CSV's time stamps that is filled in "
+                             f"(gyro and accelerometer interpolated; default {MAX_GAP_S:g} s)")
+
+
+def _read_options(args) -> dict:
+    return {"fs": args.fs, "gyr_unit": args.gyr_unit, "acc_unit": args.acc_unit, "mag_unit": args.mag_unit,
+            "max_gap": args.max_gap}
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="attitude", description="IMU attitude estimators (Rizun's optimal Wiener filter and peers).",
@@ -67,16 +82,14 @@ def build_parser() -> argparse.ArgumentParser:
     est.add_argument("input", help="CSV (t,gyr_x,gyr_y,gyr_z,acc_x,acc_y,acc_z[,mag_x,mag_y,mag_z]) or BROAD .mat")
     est.add_argument("--out", required=True, help="output CSV: t,q_w,q_x,q_y,q_z,g_x,g_y,g_z")
     est.add_argument("--method", default="wiener", choices=sorted(METHODS))
-    est.add_argument("--fs", type=float, help="sample rate in Hz (required when the CSV has no t column)")
     est.add_argument("--param", type=_param, action="append", default=[], metavar="NAME=VALUE",
                      help="parameter of the method, the gyro-offset or the heading estimator, in the unit listed "
                           "below; repeatable")
-    est.add_argument("--gyr-unit", default="rad/s", choices=["rad/s", "deg/s"])
-    est.add_argument("--acc-unit", default="m/s2", choices=["m/s2", "g"])
-    est.add_argument("--mag-unit", default="uT", choices=list(MAG_UNITS), help="magnetometer unit (default uT)")
+    _add_input_flags(est)
     _add_real_data_flags(est)
 
-    ev = sub.add_parser("evaluate", help="errors against an optical reference (BROAD .mat), beside vqf and madgwick")
+    ev = sub.add_parser("evaluate", help="errors against an optical reference (BROAD .mat, or a CSV with "
+                                         f"{','.join(REF_COLUMNS)}[,{MOVEMENT_COLUMN}]), beside vqf and madgwick")
     ev.add_argument("files", nargs="+", metavar="FILE")
     ev.add_argument("--method", default="wiener", choices=sorted(METHODS))
     ev.add_argument("--param", type=_param, action="append", default=[], metavar="NAME=VALUE")
@@ -84,6 +97,7 @@ def build_parser() -> argparse.ArgumentParser:
     ev.add_argument("--start-in-movement", type=float, metavar="S",
                     help="begin each recording S seconds into its movement phase: no rest before, "
                          "a first sample in motion (a test of start-up and offset tracking)")
+    _add_input_flags(ev)
     _add_real_data_flags(ev)
 
     pl = sub.add_parser("plot", help="a recording's error over time and its spectrum against eq. 42 (PNG)")
@@ -95,6 +109,7 @@ def build_parser() -> argparse.ArgumentParser:
     pl.add_argument("--gyro-offset", default="on", choices=["on", "off"])
     pl.add_argument("--heading", default="mag", choices=["mag", "gyro"],
                     help="with a magnetometer in the recording, also the heading error (default), or not")
+    _add_input_flags(pl)
 
     t1 = sub.add_parser("table1", help="Rizun's Table 1: analytic (eq. 50) and simulated RMS attitude error")
     t1.add_argument("--json", action="store_true", help="print JSON instead of a table")
@@ -138,16 +153,16 @@ def cmd_estimate(args) -> int:
         print(f"attitude: {text} ({now - clock:.1f} s)", file=sys.stderr, flush=True)
         clock = now
 
-    rec = read_recording(args.input, fs=args.fs, gyr_unit=args.gyr_unit, acc_unit=args.acc_unit,
-                         mag_unit=args.mag_unit)
+    rec = read_recording(args.input, **_read_options(args))
     progress(f"read {len(rec.gyr)} samples at {rec.fs:g} Hz from {args.input}")
-    note = field_norm_note(rec) if args.heading == "mag" else None
-    if note:
-        print(f"attitude: note: {note}", file=sys.stderr)
+    for note in rec.notes + ([field_norm_note(rec)] if args.heading == "mag" else []):
+        if note:
+            print(f"attitude: note: {note}", file=sys.stderr)
     result = estimate(rec.gyr, rec.acc, rec.fs, args.method, dict(args.param), offline=args.offline,
                       gyro_offset=args.gyro_offset == "on", mag=rec.mag if args.heading == "mag" else None)
     progress(f"estimated with {args.method}{' --offline' if args.offline else ''}")
-    write_estimate(args.out, rec.t, result.quat, result.up)
+    rows = slice(None) if rec.filled is None else ~rec.filled  # the input's rows, not those filled in
+    write_estimate(args.out, rec.t[rows], result.quat[rows], result.up[rows])
     progress(f"wrote {args.out}")
     if result.offset is not None:
         print("attitude: gyro offset estimate at the end "
@@ -169,7 +184,8 @@ def cmd_evaluate(args) -> int:
         raise RuntimeError(f"attitude evaluate compares with vqf and ahrs ({exc}); "
                            "install them with: pip install 'attitude-fmu[peers]'") from None
     result = evaluate(args.files, args.method, dict(args.param), args.offline, args.gyro_offset == "on",
-                      args.heading == "mag", start_in_movement=args.start_in_movement)
+                      args.heading == "mag", start_in_movement=args.start_in_movement,
+                      read_options=_read_options(args))
     if args.json:
         print(json.dumps(result, indent=2))
         return 0
@@ -187,7 +203,7 @@ def cmd_plot(args) -> int:
     from .plot import plot_recording
 
     result = plot_recording(args.file, args.out, args.method, dict(args.param), args.offline,
-                            args.gyro_offset == "on", args.heading == "mag")
+                            args.gyro_offset == "on", args.heading == "mag", _read_options(args))
     heading = f", heading RMSE {result['heading_rmse_deg']:.2f}°" if "heading_rmse_deg" in result else ""
     print(f"attitude: wrote {args.out} (inclination RMSE {result['inclination_rmse_deg']:.2f}°{heading})",
           file=sys.stderr)

@@ -11,15 +11,16 @@ import numpy as np
 from .batch import estimate
 from .compare import peer_quaternions
 from .errors import quaternion_errors
-from .recording import Recording, RecordingError, read_recording
+from .recording import Recording, read_recording
 
 METRICS = ("total_rmse_deg", "heading_rmse_deg", "inclination_rmse_deg")
 
 
 def errors_on_movement(quat, rec: Recording) -> dict:
-    """RMSE (deg) of total, heading and inclination error where `movement` is set and the
-    reference is finite (BROAD's definitions; see systems.errors.quaternion_errors)."""
-    ok = rec.movement & np.isfinite(rec.quat_ref).all(axis=1)
+    """RMSE (deg) of total, heading and inclination error over Recording.evaluated (the
+    movement phase where the reference is finite; BROAD's definitions, see
+    systems.errors.quaternion_errors)."""
+    ok = rec.evaluated()
     errors = quaternion_errors(quat[ok], rec.quat_ref[ok])
     return {name: math.degrees(float(np.sqrt(np.mean(e**2)))) for name, e in zip(METRICS, errors)}
 
@@ -28,10 +29,7 @@ def evaluate_recording(rec: Recording, method: str = "wiener", params=None, offl
                        gyro_offset: bool = True, use_mag: bool = True) -> dict:
     """{method label: {metric: value}} for one recording; with a magnetometer (and use_mag)
     the method's heading comes from it, and vqf's 9D estimate is added as "vqf_9d"."""
-    if rec.quat_ref is None or rec.movement is None:
-        raise RecordingError(f"{rec.name}: no optical reference (opt_quat and movement); cannot evaluate")
-    if not (rec.movement & np.isfinite(rec.quat_ref).all(axis=1)).any():
-        raise RecordingError(f"{rec.name}: the reference has no valid sample during movement")
+    rec.evaluated()  # refuses a recording without a usable reference before any work
     import vqf as vqf_module  # peers: the test extra (or [peers])
 
     label = f"{method}_offline" if offline else method
@@ -44,23 +42,32 @@ def evaluate_recording(rec: Recording, method: str = "wiener", params=None, offl
         "vqf_offline": errors_on_movement(vqf_module.offlineVQF(gyr, acc, None, 1.0 / rec.fs)["quat6D"], rec),
         "madgwick": errors_on_movement(peer_quaternions("madgwick", gyr, acc, rec.fs), rec),
     }
-    if mag is not None:
-        nine_d = vqf_module.VQF(1.0 / rec.fs).updateBatch(gyr, acc, np.ascontiguousarray(mag))["quat9D"]
+    if mag is not None:  # vqf's "no sample" is a zero row, where ours is NaN
+        mag = np.ascontiguousarray(np.where(np.isnan(mag).any(axis=1, keepdims=True), 0.0, mag))
+        nine_d = vqf_module.VQF(1.0 / rec.fs).updateBatch(gyr, acc, mag)["quat9D"]
         table["vqf_9d"] = errors_on_movement(nine_d, rec)
     return table
 
 
 def evaluate(paths, method: str = "wiener", params=None, offline: bool = False, gyro_offset: bool = True,
-             use_mag: bool = True, progress: bool = True, start_in_movement: float | None = None) -> dict:
+             use_mag: bool = True, progress: bool = True, start_in_movement: float | None = None,
+             read_options=None) -> dict:
     """{"recordings": {name: {label: metrics}}, "mean": {label: metrics}} over the files;
-    start_in_movement (s): cut each recording to begin that long into its movement phase."""
+    start_in_movement (s): cut each recording to begin that long into its movement phase;
+    read_options: keyword arguments of read_recording (units, fs, max_gap). progress also
+    prints how each file was read where it matters (time stamps, no movement flag)."""
     recordings = {}
     for i, path in enumerate(paths):
         if progress:
             done = int(20 * i / len(paths))
             print(f"\revaluate [{'#' * done}{'.' * (20 - done)}] {i + 1}/{len(paths)} {path}",
                   end="" if sys.stderr.isatty() else "\n", file=sys.stderr, flush=True)
-        rec = read_recording(path)
+        rec = read_recording(path, **(read_options or {}))
+        if progress:
+            notes = rec.notes + ([f"{rec.name}: no movement flag; errors over every sample with a reference"]
+                                 if rec.movement is None else [])
+            for note in notes:  # below the progress bar, which a terminal keeps on its line
+                print(f"{chr(10) if sys.stderr.isatty() else ''}attitude: note: {note}", file=sys.stderr)
         if start_in_movement is not None:
             rec = rec.into_movement(start_in_movement)
         recordings[rec.name] = evaluate_recording(rec, method, params, offline, gyro_offset, use_mag)

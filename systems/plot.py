@@ -17,24 +17,22 @@ from .recording import RecordingError, read_recording
 
 
 def plot_recording(path, out, method: str = "wiener", params=None, offline: bool = False,
-                   gyro_offset: bool = True, heading: bool = True) -> dict:
+                   gyro_offset: bool = True, heading: bool = True, read_options=None) -> dict:
     """Draw the error of method on a recording with a reference into out (PNG): the
     inclination error over time, with heading (and a magnetometer in the recording) the
     heading error with the samples the disturbance guard refused shaded and the times a
     hard-iron offset was taken or dropped marked, and the tilt error's spectrum beside eq. 42.
     Returns the inclination and (with the magnetometer) heading RMSE (deg) over the
-    movement phase."""
+    movement phase (Recording.evaluated). read_options: keyword arguments of read_recording."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    rec = read_recording(path)
-    if rec.quat_ref is None or rec.movement is None:
-        raise RecordingError(f"{rec.name}: no optical reference (opt_quat and movement); nothing to plot")
-    valid = rec.movement & np.isfinite(rec.quat_ref).all(axis=1)
+    rec = read_recording(path, **(read_options or {}))
+    valid = rec.evaluated()
     if valid.sum() < 16:
-        raise RecordingError(f"{rec.name}: too few valid reference samples during movement")
+        raise RecordingError(f"{rec.name}: too few valid reference samples to plot")
     mag = rec.mag if heading else None
     est = estimate(rec.gyr, rec.acc, rec.fs, method, params, offline=offline, gyro_offset=gyro_offset, mag=mag)
     inclination, heading_error = np.full(len(rec.gyr), np.nan), np.full(len(rec.gyr), np.nan)

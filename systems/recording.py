@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import csv
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -12,12 +12,17 @@ from blocks.earth_filters import STANDARD_GRAVITY
 
 IMU_COLUMNS = ("gyr_x", "gyr_y", "gyr_z", "acc_x", "acc_y", "acc_z")
 MAG_COLUMNS = ("mag_x", "mag_y", "mag_z")
+REF_COLUMNS = ("ref_q_w", "ref_q_x", "ref_q_y", "ref_q_z")  # optional reference orientation, sensor → earth
+MOVEMENT_COLUMN = "movement"  # optional: 1 in the phase the errors are measured over, else 0
 OUTPUT_COLUMNS = ("t", "q_w", "q_x", "q_y", "q_z", "g_x", "g_y", "g_z")
 GYR_UNITS = {"rad/s": 1.0, "deg/s": math.pi / 180.0}
 ACC_UNITS = {"m/s2": 1.0, "g": STANDARD_GRAVITY}
 MAG_UNITS = {"uT": 1.0, "nT": 1e-3, "G": 100.0, "mG": 0.1}  # to µT
 EARTH_FIELD_RANGE_UT = (20.0, 70.0)  # the geomagnetic field's norm anywhere on earth, about 22–67 µT
 MAX_GYRO_RAD_S = 40.0  # beyond the ±2000 °/s range of MEMS gyros: such values are not rad/s
+MAX_GAP_S = 1.0  # longest run of missing samples filled in by default (s)
+UNIT_TOLERANCE = 0.1  # largest departure of a reference quaternion's norm from 1 (rounded columns pass)
+JITTER_NOTE = 0.1  # time stamps off the uniform grid by more than this share of a step are noted
 
 
 class RecordingError(ValueError):
@@ -29,7 +34,9 @@ class Recording:
     """An IMU recording: gyr (rad/s), acc (m/s²), mag (µT) N×3 in sensor coordinates, fs (Hz).
 
     quat_ref (N×4, sensor → earth, NaN where lost) and movement (N, bool) come with
-    reference recordings such as BROAD's.
+    reference recordings such as BROAD's. filled (N, bool) marks the rows put into gaps of
+    a CSV's time stamps (not in the input; see _fill_gaps); notes say how the input was
+    read where a user should know it.
     """
 
     name: str
@@ -40,6 +47,21 @@ class Recording:
     mag: np.ndarray | None = None
     quat_ref: np.ndarray | None = None
     movement: np.ndarray | None = None
+    filled: np.ndarray | None = None
+    notes: list[str] = field(default_factory=list)
+
+    def evaluated(self) -> np.ndarray:
+        """(N, bool) the samples errors are measured on: the movement phase (every sample
+        when the recording has no movement flag) where the reference is finite."""
+        if self.quat_ref is None:
+            raise RecordingError(f"{self.name}: no optical reference (opt_quat, or the CSV columns "
+                                 f"{','.join(REF_COLUMNS)}); cannot evaluate")
+        phase = np.ones(len(self.gyr), dtype=bool) if self.movement is None else self.movement
+        ok = phase & np.isfinite(self.quat_ref).all(axis=1)
+        if not ok.any():
+            raise RecordingError(f"{self.name}: the reference has no valid sample"
+                                 f"{'' if self.movement is None else ' during movement'}")
+        return ok
 
     def into_movement(self, seconds: float) -> Recording:
         """The recording from `seconds` (≥ 0) after its movement phase begins: no rest
@@ -53,19 +75,25 @@ class Recording:
             raise RecordingError(f"{self.name}: the recording ends before {seconds:g} s into its movement phase")
         cut = lambda a: None if a is None else a[k:]
         return replace(self, gyr=self.gyr[k:], acc=self.acc[k:], t=self.t[k:], mag=cut(self.mag),
-                       quat_ref=cut(self.quat_ref), movement=cut(self.movement))
+                       quat_ref=cut(self.quat_ref), movement=cut(self.movement), filled=cut(self.filled))
 
 
 def read_recording(path, fs: float | None = None, gyr_unit: str = "rad/s", acc_unit: str = "m/s2",
-                   mag_unit: str = "uT") -> Recording:
-    """Read a CSV (header t,gyr_x..z,acc_x..z[,mag_x..z]; t may be replaced by fs) or a BROAD
-    .mat, in the units given (GYR_UNITS, ACC_UNITS, MAG_UNITS), into rad/s, m/s² and µT."""
+                   mag_unit: str = "uT", max_gap: float = MAX_GAP_S) -> Recording:
+    """Read a CSV (header t,gyr_x..z,acc_x..z[,mag_x..z][,ref_q_w..z][,movement]; t may be
+    replaced by fs) or a BROAD .mat, in the units given (GYR_UNITS, ACC_UNITS, MAG_UNITS),
+    into rad/s, m/s² and µT. A CSV's time stamps may jitter and skip samples: runs of
+    missing samples up to max_gap seconds are filled in (_fill_gaps), longer ones refused."""
     path = Path(path)
     if not path.is_file():
         raise RecordingError(f"{path}: no such file")
     if gyr_unit not in GYR_UNITS or acc_unit not in ACC_UNITS or mag_unit not in MAG_UNITS:
         raise RecordingError(f"units must be one of {list(GYR_UNITS)}, {list(ACC_UNITS)} and {list(MAG_UNITS)}")
-    rec = _read_mat(path) if path.suffix.lower() == ".mat" else _read_csv(path, fs)
+    if fs is not None and not (math.isfinite(fs) and fs > 0):
+        raise RecordingError(f"the sample rate must be a finite positive number of Hz, got {fs!r}")
+    if not (math.isfinite(max_gap) and max_gap >= 0):
+        raise RecordingError(f"the longest gap to fill must be a finite number of seconds ≥ 0, got {max_gap!r}")
+    rec = _read_mat(path) if path.suffix.lower() == ".mat" else _read_csv(path, fs, max_gap)
     if fs is not None and abs(rec.fs - fs) > 0.01 * fs:
         raise RecordingError(f"{path}: --fs {fs:g} Hz disagrees with the recording's {rec.fs:g} Hz")
     rec.gyr = rec.gyr * GYR_UNITS[gyr_unit]
@@ -95,7 +123,7 @@ def field_norm_note(rec: Recording) -> str | None:
             "works in any unit; the hard-iron offset is reported in the input's")
 
 
-def _read_csv(path: Path, fs: float | None) -> Recording:
+def _read_csv(path: Path, fs: float | None, max_gap: float) -> Recording:
     with path.open(newline="") as fh:
         header = next(csv.reader(fh), None)
     if not header:
@@ -104,6 +132,10 @@ def _read_csv(path: Path, fs: float | None) -> Recording:
     missing = [c for c in IMU_COLUMNS if c not in header]
     if missing:
         raise RecordingError(f"{path}: missing columns {', '.join(missing)} (header: {','.join(header)})")
+    ref_given = [c for c in REF_COLUMNS if c in header]
+    if ref_given and len(ref_given) < len(REF_COLUMNS):
+        raise RecordingError(f"{path}: the reference needs all of {','.join(REF_COLUMNS)}, "
+                             f"the header has only {','.join(ref_given)}")
     if "t" not in header and fs is None:
         raise RecordingError(f"{path}: no 't' column; give the sample rate with --fs HZ")
     try:
@@ -113,30 +145,94 @@ def _read_csv(path: Path, fs: float | None) -> Recording:
     if data.shape[0] == 0 or data.shape[1] != len(header):
         raise RecordingError(f"{path}: expected {len(header)} columns of numbers and at least one row")
     col = {name: data[:, i] for i, name in enumerate(header)}
-    if "t" in col:
-        t = col["t"]
-        if not np.isfinite(t).all():
-            raise RecordingError(f"{path}: column t has non-finite values")
-        fs = _rate_from_times(path, t)
-    else:
-        t = np.arange(1, data.shape[0] + 1) / fs
-    mag = np.column_stack([col[c] for c in MAG_COLUMNS]) if all(c in col for c in MAG_COLUMNS) else None
-    return Recording(
-        path.stem, float(fs), np.column_stack([col[c] for c in IMU_COLUMNS[:3]]),
-        np.column_stack([col[c] for c in IMU_COLUMNS[3:]]), t, mag,
-    )
+    columns = lambda names: np.column_stack([col[c] for c in names]) if all(c in col for c in names) else None
+    movement = col.get(MOVEMENT_COLUMN)
+    rec = Recording(path.stem, 0.0, columns(IMU_COLUMNS[:3]), columns(IMU_COLUMNS[3:]), col.get("t"),
+                    columns(MAG_COLUMNS), columns(REF_COLUMNS),
+                    None if movement is None else _flag(path, MOVEMENT_COLUMN, movement))
+    if rec.t is None:
+        rec.fs, rec.t = float(fs), np.arange(1, data.shape[0] + 1) / fs
+        return rec
+    if not np.isfinite(rec.t).all():
+        raise RecordingError(f"{path}: column t has non-finite values")
+    index, rec.fs, off_grid = _sample_grid(path, rec.t, max_gap)
+    if off_grid > JITTER_NOTE:
+        rec.notes.append(f"{rec.name}: time stamps up to {off_grid:.0%} of a step off a uniform grid; "
+                         f"the samples are taken as uniform at {rec.fs:.6g} Hz")
+    if index[-1] + 1 > len(index):
+        rec = _fill_gaps(rec, index)
+    return rec
 
 
-def _rate_from_times(path: Path, t: np.ndarray) -> float:
+def _sample_grid(path: Path, t: np.ndarray, max_gap: float) -> tuple[np.ndarray, float, float]:
+    """(index of each row on a uniform grid, its rate in Hz, largest distance of a time
+    stamp from the grid in steps). Each time step counts as the whole number of median
+    steps nearest to it, so jitter below half a step is tolerated and a longer step is a
+    run of missing samples; the rate comes from the whole span, so rounded time stamps
+    do not bias it."""
     if len(t) < 2:
         raise RecordingError(f"{path}: one sample cannot give a sample rate; give --fs HZ")
     dt = np.diff(t)
+    if np.any(dt <= 0):
+        r = int(np.argmax(dt <= 0))
+        raise RecordingError(f"{path}: column t must increase strictly (row {r + 2}: {t[r + 1]:g} s after {t[r]:g} s)")
     step = float(np.median(dt))
-    if step <= 0 or np.any(dt <= 0):
-        raise RecordingError(f"{path}: column t must increase strictly")
-    if np.max(np.abs(dt - step)) > 0.01 * step:
-        raise RecordingError(f"{path}: column t is not uniformly sampled (steps {dt.min():g}…{dt.max():g} s)")
-    return 1.0 / step
+    count = np.rint(dt / step)
+    if np.any(count < 1):
+        r = int(np.argmax(count < 1))
+        raise RecordingError(f"{path}: column t is irregular: the step to row {r + 2} is {dt[r]:g} s, "
+                             f"less than half the usual {step:g} s")
+    index = np.concatenate([[0], np.cumsum(count)]).astype(np.int64)
+    fs = float(index[-1] / (t[-1] - t[0]))
+    off_grid = float(np.max(np.abs(t - t[0] - index / fs)) * fs)
+    if off_grid > 0.5:
+        raise RecordingError(f"{path}: column t is irregular: time stamps up to {off_grid:.1f} steps off "
+                             f"a uniform grid at {fs:.6g} Hz (does the sample rate change?)")
+    r = int(np.argmax(count))
+    if (count[r] - 1) / fs > max_gap:
+        raise RecordingError(f"{path}: {int(count[r]) - 1} samples missing after row {r + 1} (t = {t[r]:g} s), "
+                             f"a gap of {(count[r] - 1) / fs:g} s, longer than --max-gap {max_gap:g} s; "
+                             "split the recording there or raise --max-gap")
+    return index, fs, off_grid
+
+
+def _fill_gaps(rec: Recording, index: np.ndarray) -> Recording:
+    """rec on its whole uniform grid (rows at index, ascending from 0): the rows put into
+    the gaps have gyro, accelerometer and time interpolated linearly between the rows
+    either side, no magnetometer or reference sample (NaN) and the movement flag of the
+    row before; filled marks them."""
+    grid = np.arange(index[-1] + 1)
+    filled = np.ones(len(grid), dtype=bool)
+    filled[index] = False
+    interpolated = lambda a: np.column_stack([np.interp(grid, index, c) for c in a.T])
+
+    def absent(a):
+        if a is None:
+            return None
+        out = np.full((len(grid), a.shape[1]), np.nan)
+        out[index] = a
+        return out
+
+    gaps = np.diff(index) - 1
+    count = int((gaps > 0).sum())
+    rec.notes.append(f"{rec.name}: {int(gaps.sum())} missing samples in {count} gap{'s' * (count > 1)} "
+                     f"(the longest {gaps.max() / rec.fs:g} s) filled in: gyro and accelerometer interpolated "
+                     "linearly, no magnetometer or reference sample there; estimates are written for the "
+                     "input's rows only")
+    return replace(rec, gyr=interpolated(rec.gyr), acc=interpolated(rec.acc),
+                   t=np.interp(grid, index, rec.t), mag=absent(rec.mag), quat_ref=absent(rec.quat_ref),
+                   movement=None if rec.movement is None else rec.movement[np.searchsorted(index, grid, "right") - 1],
+                   filled=filled)
+
+
+def _flag(path: Path, name: str, values) -> np.ndarray:
+    """A 0/1 column as booleans; anything else is refused."""
+    values = np.asarray(values, dtype=float)
+    bad = (values != 0) & (values != 1)
+    if bad.any():
+        r = int(np.argmax(bad))
+        raise RecordingError(f"{path}: {name} must be 0 or 1, row {r + 1} has {values[r]:g}")
+    return values == 1
 
 
 def _read_mat(path: Path) -> Recording:
@@ -149,7 +245,10 @@ def _read_mat(path: Path) -> Recording:
     missing = [k for k in ("imu_gyr", "imu_acc", "sampling_rate") if k not in mat]
     if missing:
         raise RecordingError(f"{path}: missing variables {', '.join(missing)} (expected a BROAD recording)")
-    fs = float(mat["sampling_rate"])
+    try:
+        fs = float(mat["sampling_rate"])
+    except (TypeError, ValueError):
+        raise RecordingError(f"{path}: sampling_rate must be one number (Hz)") from None
     gyr = np.atleast_2d(np.asarray(mat["imu_gyr"], dtype=float))
     acc = np.atleast_2d(np.asarray(mat["imu_acc"], dtype=float))
     n = len(gyr)
@@ -158,13 +257,15 @@ def _read_mat(path: Path) -> Recording:
         if key not in mat:
             return None
         value = np.asarray(mat[key], dtype=float)
-        value = value.reshape(n, width) if width else value.reshape(n)
-        return value
+        if value.size != n * max(width, 1):
+            raise RecordingError(f"{path}: {key} has {value.size} values, expected {n}"
+                                 f"{f'×{width}' if width else ''} (one per sample of imu_gyr)")
+        return value.reshape(n, width) if width else value.reshape(n)
 
     movement = optional("movement", 0)
     return Recording(
         path.stem, fs, gyr, acc, np.arange(1, n + 1) / fs, optional("imu_mag", 3),
-        optional("opt_quat", 4), None if movement is None else movement.astype(bool),
+        optional("opt_quat", 4), None if movement is None else _flag(path, "movement", movement),
     )
 
 
@@ -190,6 +291,13 @@ def _check_values(rec: Recording) -> None:
         raise RecordingError(f"{rec.name}: median accelerometer norm is {norm:.2f}: looks like g; pass --acc-unit g")
     if not 4.0 < norm < 20.0:
         raise RecordingError(f"{rec.name}: median accelerometer norm is {norm:.3g}, far from gravity; expected m/s²")
+    if rec.quat_ref is not None:
+        norm = np.linalg.norm(rec.quat_ref, axis=1)
+        bad = np.isfinite(norm) & (np.abs(norm - 1.0) > UNIT_TOLERANCE)
+        if bad.any():
+            row = int(np.argmax(bad))
+            raise RecordingError(f"{rec.name}: the reference quaternion in row {row + 1} has the norm "
+                                 f"{norm[row]:.3g}; expected unit quaternions w,x,y,z (NaN where lost)")
 
 
 def write_estimate(path, t, quat, up) -> None:

@@ -122,7 +122,7 @@ def _bad_inputs(tmp_path, gyr, acc):
     cases["deg/s"] = ({**cols, **{f"gyr_{a}": np.degrees(cols[f"gyr_{a}"]) * 10 for a in "xyz"}}, [])
     cases["looks like g"] = ({**cols, **{f"acc_{a}": cols[f"acc_{a}"] / 9.81 for a in "xyz"}}, [])
     jitter = dict(cols, t=cols["t"] * (1 + 0.2 * (np.arange(len(gyr)) % 2) / len(gyr)) + (np.arange(len(gyr)) % 3) * 0.004)
-    cases["not uniformly sampled"] = (jitter, [])
+    cases["column t is irregular"] = (jitter, [])
     cases["unknown parameter"] = (cols, ["--param", "delta_q=1"])
     cases["unknown parameter 'mag_norm_tol'"] = (cols, ["--param", "mag_norm_tol=0.2"])  # no magnetometer
     cases["finite positive"] = (cols, ["--param", "delta_n=-1"])

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 from scipy import integrate
-from scipy.io import savemat
+from scipy.io import loadmat, savemat
 from scipy.spatial.transform import Rotation
 
 from blocks import accuracy as ac
@@ -235,18 +235,22 @@ def test_evaluate_json_contract_on_synthetic_recordings(tmp_path, capsys):
     assert "ends before 100 s into its movement phase" in capsys.readouterr().err
 
 
-@pytest.mark.parametrize("case", ["no reference", "no movement flag", "corrupted"])
+@pytest.mark.parametrize("case", ["no optical reference", "no valid sample during movement", "not a readable"])
 def test_evaluate_without_reference_or_on_a_broken_file_fails_cleanly(tmp_path, capsys, case):
     motion = ClosedFormMotion("still", lambda t: Rotation.from_rotvec(np.zeros((len(t), 3))),
                               lambda t: np.zeros((len(t), 3))).generate(10.0, FS)
     path = tmp_path / "rec.mat"
-    if case == "corrupted":
+    if case == "not a readable":
         path.write_bytes(b"MATLAB 5.0 MAT-file; broken on purpose")
     else:
-        _broad_like(path, motion, quat_ref=case != "no reference", movement=case != "no movement flag")
+        _broad_like(path, motion, quat_ref=case != "no optical reference")
+        if case == "no valid sample during movement":  # the optical system lost the body throughout
+            data = loadmat(path)
+            savemat(path, {**{k: v for k, v in data.items() if not k.startswith("__")},
+                           "opt_quat": np.full_like(data["opt_quat"], np.nan)})
     assert main(["evaluate", str(path)]) == 2
     err = capsys.readouterr().err
-    assert "attitude: error:" in err and "Traceback" not in err
+    assert "attitude: error:" in err and case in err and "Traceback" not in err, err
 
 
 def test_quaternion_errors_split_heading_from_inclination():
