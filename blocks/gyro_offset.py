@@ -25,7 +25,11 @@ c. Guards, all from the same model:
   components across it; directions in which H keeps less than half of them are left
   alone, since a sensor-fixed (e.g. centripetal) acceleration looks the same there;
 - innovations are clipped at 4·sigma_init, the fastest turn a plausible offset makes;
-- no update in the first 3·tau_acc, while the low-pass forgets its first sample.
+- over the first tau_acc the accelerometer's low-pass is the running mean of its samples
+  in the gyro frame (as the Wiener filter starts), not a Butterworth from the first
+  sample, which in motion can be off by metres per second squared and would turn the
+  low-passed direction for several tau_acc after; no update in the first 3·tau_acc,
+  while the low-passes forget their start.
 The corrected gyro is the measured one minus the estimate after its sample. Causal, one
 compiled step per sample.
 """
@@ -98,12 +102,12 @@ def coefficients(params, Ts: float) -> np.ndarray:
 
 def initial_state(coef, gyr0, acc0) -> np.ndarray:
     """Low-passes (both) on the first samples, not at rest, no offset (variance P0), the gyro
-    frame on the sensor, its low-passes settled on acc0 and R = I."""
+    frame on the sensor, the low-pass of R settled on I (that of the accelerometer starts
+    as the running mean of the first samples)."""
     state = np.zeros(len(STATE_NAMES))
     state[0:3], state[3:6] = gyr0, acc0
     state[SHORT:SHORT + 3], state[SHORT + 3:SHORT + 6] = gyr0, acc0
     state[QUAT] = (1.0, 0.0, 0.0, 0.0)
-    state[ACC_LP][0:3] = acc0
     state[R_LP][0:9] = np.eye(3).ravel()
     state[COV] = coef[8] * np.eye(3).ravel()
     return state
@@ -157,7 +161,8 @@ def run(state, coef, gyr, acc, offset, variance):
     per axis (N×3, (rad/s)²)."""
     Ts, a_lp, r, rest_gyr, rest_gyr_abs, rest_acc, rest_time, wt, P0, V, W, a_short = (
         coef[0], coef[1], coef[2], coef[3], coef[4], coef[5], coef[6], coef[7], coef[8], coef[9], coef[10], coef[11])
-    settle = SETTLE_TAUS * math.sqrt(2.0) * Ts / wt
+    start_mean = math.sqrt(2.0) * Ts / wt  # tau_acc
+    settle = SETTLE_TAUS * start_mean
     clip = CLIP_SIGMAS * math.sqrt(P0)
     Ad, Bd = np.empty((2, 2)), np.empty(2)
     butterworth_zoh(wt, Ad, Bd)
@@ -190,8 +195,13 @@ def run(state, coef, gyr, acc, offset, variance):
             # the accelerometer, R·b and R (column j: the sensor's axis j) low-passed
             a = quat_rotate(q, (acc[k, 0], acc[k, 1], acc[k, 2]))
             rb = quat_rotate(q, (b[0], b[1], b[2]))
+            mean = state[T] <= start_mean
             for i in range(3):
-                lowpass_step(acc_lp, i, a[i], Ad, Bd)
+                if mean:  # the running mean, derivative row at rest
+                    acc_lp[0, i] += Ts / state[T] * (a[i] - acc_lp[0, i])
+                    acc_lp[1, i] = 0.0
+                else:
+                    lowpass_step(acc_lp, i, a[i], Ad, Bd)
                 lowpass_step(rb_lp, i, rb[i], Ad, Bd)
             for j in range(3):
                 col = quat_rotate(q, (1.0 if j == 0 else 0.0, 1.0 if j == 1 else 0.0, 1.0 if j == 2 else 0.0))
