@@ -124,7 +124,7 @@ def field_norm_note(rec: Recording) -> str | None:
 
 
 def _read_csv(path: Path, fs: float | None, max_gap: float) -> Recording:
-    with path.open(newline="") as fh:
+    with path.open(newline="", encoding="utf-8-sig") as fh:  # a spreadsheet's byte-order mark is not a name
         header = next(csv.reader(fh), None)
     if not header:
         raise RecordingError(f"{path}: empty file; expected a header t,{','.join(IMU_COLUMNS)}")

@@ -57,6 +57,18 @@ def test_rounded_and_jittering_time_stamps_give_the_rate_of_the_whole_span(tmp_p
         assert ("off a uniform grid; the samples are taken as uniform at 285.7 Hz" in err) == noted, err
 
 
+def test_a_spreadsheets_header_reads_as_ours(tmp_path, recording):
+    """A byte-order mark and spaces around the names (as spreadsheets export) change nothing."""
+    _, gyr, acc, _ = recording
+    t = np.arange(1, 101) / FS
+    _write(tmp_path / "plain.csv", t, gyr[:100], acc[:100])
+    lines = (tmp_path / "plain.csv").read_text().splitlines()
+    header = "\ufeff" + ", ".join(lines[0].split(","))
+    (tmp_path / "sheet.csv").write_text("\n".join([header, *lines[1:]]) + "\n", encoding="utf-8")
+    plain, sheet = read_recording(tmp_path / "plain.csv"), read_recording(tmp_path / "sheet.csv")
+    assert sheet.fs == plain.fs and np.array_equal(sheet.gyr, plain.gyr) and np.array_equal(sheet.acc, plain.acc)
+
+
 def test_missing_samples_are_filled_in_and_the_output_keeps_the_input_rows(tmp_path, recording, capsys):
     """30 runs of 1–29 dropped samples: filled in (gyro and accelerometer interpolated), the
     inclination error at the rows kept is at most 60 % of that of the same rows taken as
