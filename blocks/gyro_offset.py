@@ -10,7 +10,10 @@ of the rest's samples, and a long rest settles on a window of delta_n/sigma_moti
 √(tau_motion/2) s (7 s by default), whatever the sample rate. Without the short low-pass
 (raw samples, as vqf tests them) a gyro whose white noise alone comes near rest_gyr
 (δn·√(3·fs/2), e.g. 0.1 °/s/√Hz at 250 Hz) would seldom or never rest; through it the
-noise is δn·√(3/(4·tau_short)), 0.6 °/s for 0.1 °/s/√Hz at any rate.
+noise is δn·√(3/(4·tau_short)), 0.6 °/s for 0.1 °/s/√Hz at any rate. A noisier gyro
+(delta_n given) raises the threshold to REST_NOISE_SIGMAS times its per-axis noise
+there, δn/√(4·tau_short), so that its own noise does not break every rest (up to
+0.125 °/s/√Hz the default rest_gyr is above that floor).
 
 While moving, the offset's effect on the accelerometer is tracked in the gyro frame (the
 frame integrated from the corrected gyro; R its sensor → gyro-frame rotation), the way
@@ -48,7 +51,8 @@ from .wiener_local import butterworth_zoh
 
 PARAMS = (
     Param("rest_gyr", math.radians(2.0), "rad/s",
-          "largest deviation of the gyro (through tau_short) from its low-pass at rest"),
+          "largest deviation of the gyro (through tau_short) from its low-pass at rest; at least "
+          "4.5 times delta_n's noise through tau_short"),
     Param("rest_gyr_abs", math.radians(5.0), "rad/s", "largest low-passed gyro norm at rest (offset included)"),
     Param("rest_acc", 0.5, "m/s²",
           "largest deviation of the accelerometer (through tau_short) from its low-pass at rest"),
@@ -78,6 +82,7 @@ STATE_NAMES = (
 T, QUAT, ACC_LP, R_LP, RB_LP, COV, SHORT = 10, slice(11, 15), slice(15, 21), slice(21, 39), slice(39, 45), slice(45, 54), 54
 OBSERVED = 0.5  # the least share of an offset's effect H must keep in a direction to update it
 CLIP_SIGMAS = 4.0  # innovations clipped at this many sigma_init
+REST_NOISE_SIGMAS = 4.5  # the least rest_gyr in units of the gyro noise's per-axis s.d. through tau_short
 SETTLE_TAUS = 3.0  # no update before this many tau_acc (the low-pass forgetting its start)
 
 
@@ -88,14 +93,16 @@ def resolve(overrides=None) -> dict:
 def coefficients(params, Ts: float) -> np.ndarray:
     """[Ts, a_lp, r, rest_gyr, rest_gyr_abs, rest_acc, rest_time, ω_acc·Ts, P0, V, W, a_short]:
     a_* = 1 − exp(−Ts/τ_*), r = δn²/(2·Ts) the variance of a gyro sample's white noise
-    ((rad/s)²), ω_acc = √2/τ_acc (rad/s); the Kalman filter has the initial variance
-    P0 = σ_init², the process noise V = σ_motion²·Ts/τ_motion per sample and, while moving,
-    the measurement noise W = σ_motion⁴/V + σ_motion², with which its variance settles on
-    σ_motion² (V = 0: no tracking while moving)."""
+    ((rad/s)²), rest_gyr at least REST_NOISE_SIGMAS·δn/√(4·τ_short), ω_acc = √2/τ_acc
+    (rad/s); the Kalman filter has the initial variance P0 = σ_init², the process noise
+    V = σ_motion²·Ts/τ_motion per sample and, while moving, the measurement noise
+    W = σ_motion⁴/V + σ_motion², with which its variance settles on σ_motion² (V = 0: no
+    tracking while moving)."""
     tau_motion, s2 = params["tau_motion"], params["sigma_motion"] ** 2
     V = s2 * Ts / tau_motion if tau_motion > 0 else 0.0
     return np.array([Ts, 1.0 - math.exp(-Ts / params["tau_lp"]), params["delta_n"] ** 2 / (2.0 * Ts),
-                     params["rest_gyr"], params["rest_gyr_abs"], params["rest_acc"], params["rest_time"],
+                     max(params["rest_gyr"], REST_NOISE_SIGMAS * params["delta_n"] / math.sqrt(4 * params["tau_short"])),
+                     params["rest_gyr_abs"], params["rest_acc"], params["rest_time"],
                      math.sqrt(2.0) / params["tau_acc"] * Ts, params["sigma_init"] ** 2, V,
                      s2 * s2 / V + s2 if V > 0 else 0.0, 1.0 - math.exp(-Ts / params["tau_short"])])
 

@@ -12,7 +12,9 @@ from scipy.spatial.transform import Rotation
 
 from blocks import accuracy as ac
 from blocks import earth_filters as ef
+from blocks.gyro_offset import coefficients as offset_coefficients
 from blocks.gyro_offset import correct as correct_gyro
+from blocks.gyro_offset import resolve as resolve_offset_params
 from blocks.heading import with_magnetometer
 from systems import experiments as ex
 from systems.batch import estimate
@@ -94,19 +96,39 @@ def test_gyro_offset_converges_and_attitude_stays_bounded_over_an_hour():
     assert without[after_first_rest:].max() > 4 * inclination[after_first_rest:].max()
 
 
+def _first_rest_offset_error(density):
+    """Offset error (°/s, largest axis) when the motion starts after the first minute's
+    rest at 250 Hz, for a gyro of the density (°/s/√Hz) with 1 °/s on every axis, as a
+    function of the estimator's parameters."""
+    fs = 250.0
+    offset = np.radians([1.0, -1.0, 1.0])
+    gyr, acc = ImuModel(delta_n=math.radians(density), gyr_offset=tuple(offset),
+                        acc_noise=0.002).apply(_motion_with_rests(70.0, fs), seed=5)
+    return lambda params: np.degrees(np.abs(correct_gyro(gyr, acc, fs, params)[1][int(60 * fs)] - offset)).max()
+
+
 def test_a_noisy_gyro_at_a_high_rate_still_finds_rest():
     """0.1 °/s/√Hz at 250 Hz: white noise alone deviates about 2 °/s per sample, so a
-    per-sample rest test (tau_short → 0) never finds the first minute's rest; through
+    per-sample rest test at rest_gyr (tau_short → 0, as vqf's; delta_n → 0 keeps the
+    threshold from rising with the noise) never finds the first minute's rest; through
     the short low-pass it does, and the offset is known when the motion starts."""
-    fs = 250.0
-    motion = _motion_with_rests(70.0, fs)
-    offset = np.radians([1.0, -1.0, 1.0])
-    gyr, acc = ImuModel(delta_n=math.radians(0.1), gyr_offset=tuple(offset), acc_noise=0.002).apply(motion, seed=5)
-    at_motion = int(60 * fs)
-    error = lambda params: np.degrees(np.abs(correct_gyro(gyr, acc, fs, params)[1][at_motion] - offset)).max()
-    print(f"offset error when the motion starts: {error({}):.3f} °/s, per-sample test {error({'tau_short': 1e-9}):.3f} °/s")
+    error = _first_rest_offset_error(0.1)
+    per_sample = {"tau_short": 1e-9, "delta_n": 1e-12}
+    print(f"offset error when the motion starts: {error({}):.3f} °/s, per-sample test {error(per_sample):.3f} °/s")
     assert error({}) < 0.05
-    assert error({"tau_short": 1e-9}) > 0.5
+    assert error(per_sample) > 0.5
+
+
+def test_a_gyro_told_noisier_raises_the_rest_threshold_above_its_noise():
+    """0.3 °/s/√Hz: through tau_short each axis has 1.06 °/s of noise, and the norm of the
+    deviation exceeds the default rest_gyr (2 °/s) often enough that no rest lasts 1.5 s.
+    Told delta_n, the threshold is 4.5 times that noise: the first minute's rest gives the
+    offset. At the default density the floor (1.6 °/s) is below rest_gyr, which holds."""
+    error = _first_rest_offset_error(0.3)
+    told, untold = error({"delta_n": math.radians(0.3)}), error({})
+    print(f"offset error when the motion starts: delta_n told {told:.3f} °/s, untold {untold:.3f} °/s")
+    assert told < 0.1 and untold > 0.5
+    assert offset_coefficients(resolve_offset_params(), 0.01)[3] == math.radians(2.0)
 
 
 def test_a_short_rest_gives_the_mean_of_its_gyro_samples():
