@@ -168,7 +168,8 @@ def cmd_estimate(args) -> int:
         print("attitude: gyro offset estimate at the end "
               f"({', '.join(f'{v:.3f}' for v in np.degrees(result.offset[-1]))}) °/s", file=sys.stderr)
     if result.mag_accepted is not None:
-        print(f"attitude: magnetometer samples used for heading {100 * result.mag_accepted.mean():.0f} %, "
+        sampled = np.isfinite(rec.mag).all(axis=1)  # rows where a slower magnetometer has a sample
+        print(f"attitude: magnetometer samples used for heading {100 * result.mag_accepted[sampled].mean():.0f} %, "
               f"hard-iron offset at the end ({', '.join(f'{v:.1f}' for v in result.mag_offset[-1])}) µT",
               file=sys.stderr)
     return 0

@@ -93,6 +93,17 @@ def test_estimate_takes_the_magnetometer_unit_and_notes_a_norm_far_from_the_eart
     assert np.abs(outputs[0][:, 1:5] - estimate(gyr, acc, FS, gyro_offset=True, mag=field).quat).max() < 1e-9
 
 
+def test_the_share_of_magnetometer_samples_used_counts_the_samples_there_are(tmp_path, imu, capsys):
+    """A magnetometer at a quarter of the rate (NaN in between) on an undisturbed field: every
+    one of its samples is used, not 25 % of the rows."""
+    gyr, acc = imu
+    field = HumanMotion(delta_v=0.1, omega_c=5.0).generate(30.0, FS, seed=11).mag  # the imu fixture's motion
+    field[np.arange(len(field)) % 4 != 0] = np.nan
+    _write_csv(tmp_path / "in.csv", {**_imu_columns(gyr, acc), **{f"mag_{a}": field[:, i] for i, a in enumerate("xyz")}})
+    assert main(["estimate", str(tmp_path / "in.csv"), "--out", str(tmp_path / "out.csv")]) == 0
+    assert "magnetometer samples used for heading 100 %" in capsys.readouterr().err
+
+
 def test_estimate_reads_a_broad_mat_recording(tmp_path, imu, capsys):
     gyr, acc = imu
     mag = np.tile([0.0, 20.0, -45.0], (len(gyr), 1))
