@@ -13,7 +13,7 @@ from blocks.methods import METHODS
 from blocks.methods import method as known_method
 from blocks.stages import ESTIMATORS
 
-from .recording import ACC_UNITS, GYR_UNITS, MAG_UNITS, MAX_GAP_S, MOVEMENT_COLUMN, REF_COLUMNS
+from .recording import ACC_UNITS, GYR_UNITS, MAG_UNITS, MAX_GAP_S, MOVEMENT_COLUMN, REF_COLUMNS, T_UNITS
 
 EXIT_BAD_INPUT = 2
 EXIT_CHECK_FAILED = 1
@@ -58,6 +58,7 @@ def _add_input_flags(parser) -> None:
     parser.add_argument("--gyr-unit", default="rad/s", choices=list(GYR_UNITS))
     parser.add_argument("--acc-unit", default="m/s2", choices=list(ACC_UNITS))
     parser.add_argument("--mag-unit", default="uT", choices=list(MAG_UNITS), help="magnetometer unit (default uT)")
+    parser.add_argument("--t-unit", default="s", choices=list(T_UNITS), help="unit of a CSV's t column (default s)")
     parser.add_argument("--max-gap", type=float, default=MAX_GAP_S, metavar="S",
                         help="longest run of samples missing from a CSV's time stamps that is filled in "
                              f"(gyro and accelerometer interpolated; default {MAX_GAP_S:g} s)")
@@ -65,7 +66,7 @@ def _add_input_flags(parser) -> None:
 
 def _read_options(args) -> dict:
     return {"fs": args.fs, "gyr_unit": args.gyr_unit, "acc_unit": args.acc_unit, "mag_unit": args.mag_unit,
-            "max_gap": args.max_gap}
+            "max_gap": args.max_gap, "t_unit": args.t_unit}
 
 
 def build_parser() -> argparse.ArgumentParser:

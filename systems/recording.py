@@ -18,6 +18,8 @@ OUTPUT_COLUMNS = ("t", "q_w", "q_x", "q_y", "q_z", "g_x", "g_y", "g_z")
 GYR_UNITS = {"rad/s": 1.0, "deg/s": math.pi / 180.0}
 ACC_UNITS = {"m/s2": 1.0, "g": STANDARD_GRAVITY}
 MAG_UNITS = {"uT": 1.0, "nT": 1e-3, "G": 100.0, "mG": 0.1}  # to µT
+T_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}  # to s
+RATE_RANGE_HZ = (1.0, 1e5)  # sample rates an IMU recording can have; outside, the time unit is wrong
 EARTH_FIELD_RANGE_UT = (20.0, 70.0)  # the geomagnetic field's norm anywhere on earth, about 22–67 µT
 MAX_GYRO_RAD_S = 40.0  # beyond the ±2000 °/s range of MEMS gyros: such values are not rad/s
 MAX_GAP_S = 1.0  # longest run of missing samples filled in by default (s)
@@ -79,21 +81,23 @@ class Recording:
 
 
 def read_recording(path, fs: float | None = None, gyr_unit: str = "rad/s", acc_unit: str = "m/s2",
-                   mag_unit: str = "uT", max_gap: float = MAX_GAP_S) -> Recording:
+                   mag_unit: str = "uT", max_gap: float = MAX_GAP_S, t_unit: str = "s") -> Recording:
     """Read a CSV (header t,gyr_x..z,acc_x..z[,mag_x..z][,ref_q_w..z][,movement]; t may be
-    replaced by fs) or a BROAD .mat, in the units given (GYR_UNITS, ACC_UNITS, MAG_UNITS),
-    into rad/s, m/s² and µT. A CSV's time stamps may jitter and skip samples: runs of
-    missing samples up to max_gap seconds are filled in (_fill_gaps), longer ones refused."""
+    replaced by fs) or a BROAD .mat, in the units given (GYR_UNITS, ACC_UNITS, MAG_UNITS,
+    T_UNITS), into rad/s, m/s², µT and s. A CSV's time stamps may jitter and skip samples:
+    runs of missing samples up to max_gap seconds are filled in (_fill_gaps), longer ones
+    refused."""
     path = Path(path)
     if not path.is_file():
         raise RecordingError(f"{path}: no such file")
-    if gyr_unit not in GYR_UNITS or acc_unit not in ACC_UNITS or mag_unit not in MAG_UNITS:
-        raise RecordingError(f"units must be one of {list(GYR_UNITS)}, {list(ACC_UNITS)} and {list(MAG_UNITS)}")
+    units = ((gyr_unit, GYR_UNITS), (acc_unit, ACC_UNITS), (mag_unit, MAG_UNITS), (t_unit, T_UNITS))
+    if any(unit not in known for unit, known in units):
+        raise RecordingError(f"units must be one of {', '.join(str(list(known)) for _, known in units)}")
     if fs is not None and not (math.isfinite(fs) and fs > 0):
         raise RecordingError(f"the sample rate must be a finite positive number of Hz, got {fs!r}")
     if not (math.isfinite(max_gap) and max_gap >= 0):
         raise RecordingError(f"the longest gap to fill must be a finite number of seconds ≥ 0, got {max_gap!r}")
-    rec = _read_mat(path) if path.suffix.lower() == ".mat" else _read_csv(path, fs, max_gap)
+    rec = _read_mat(path) if path.suffix.lower() == ".mat" else _read_csv(path, fs, max_gap, T_UNITS[t_unit])
     if fs is not None and abs(rec.fs - fs) > 0.01 * fs:
         raise RecordingError(f"{path}: --fs {fs:g} Hz disagrees with the recording's {rec.fs:g} Hz")
     rec.gyr = rec.gyr * GYR_UNITS[gyr_unit]
@@ -123,7 +127,7 @@ def field_norm_note(rec: Recording) -> str | None:
             "works in any unit; the hard-iron offset is reported in the input's")
 
 
-def _read_csv(path: Path, fs: float | None, max_gap: float) -> Recording:
+def _read_csv(path: Path, fs: float | None, max_gap: float, t_scale: float) -> Recording:
     with path.open(newline="", encoding="utf-8-sig") as fh:  # a spreadsheet's byte-order mark is not a name
         header = next(csv.reader(fh), None)
     if not header:
@@ -147,7 +151,8 @@ def _read_csv(path: Path, fs: float | None, max_gap: float) -> Recording:
     col = {name: data[:, i] for i, name in enumerate(header)}
     columns = lambda names: np.column_stack([col[c] for c in names]) if all(c in col for c in names) else None
     movement = col.get(MOVEMENT_COLUMN)
-    rec = Recording(path.stem, 0.0, columns(IMU_COLUMNS[:3]), columns(IMU_COLUMNS[3:]), col.get("t"),
+    rec = Recording(path.stem, 0.0, columns(IMU_COLUMNS[:3]), columns(IMU_COLUMNS[3:]),
+                    None if "t" not in col else col["t"] * t_scale,
                     columns(MAG_COLUMNS), columns(REF_COLUMNS),
                     None if movement is None else _flag(path, MOVEMENT_COLUMN, movement))
     if rec.t is None:
@@ -184,6 +189,7 @@ def _sample_grid(path: Path, t: np.ndarray, max_gap: float) -> tuple[np.ndarray,
                              f"less than half the usual {step:g} s")
     index = np.concatenate([[0], np.cumsum(count)]).astype(np.int64)
     fs = float(index[-1] / (t[-1] - t[0]))
+    _check_rate(path, fs)  # before the gaps, which a wrong time unit makes look long
     off_grid = float(np.max(np.abs(t - t[0] - index / fs)) * fs)
     if off_grid > 0.5:
         raise RecordingError(f"{path}: column t is irregular: time stamps up to {off_grid:.1f} steps off "
@@ -269,6 +275,13 @@ def _read_mat(path: Path) -> Recording:
     )
 
 
+def _check_rate(name, fs: float) -> None:
+    low, high = RATE_RANGE_HZ
+    if not (math.isfinite(fs) and low <= fs <= high):
+        raise RecordingError(f"{name}: a sample rate of {fs:.6g} Hz is outside the {low:g}–{high:g} Hz of IMUs; "
+                             f"are the time stamps in seconds? If not, pass --t-unit ({', '.join(T_UNITS)})")
+
+
 def _check_values(rec: Recording) -> None:
     for name in ("gyr", "acc"):
         a = getattr(rec, name)
@@ -278,8 +291,7 @@ def _check_values(rec: Recording) -> None:
         if bad.any():
             row = int(np.argwhere(bad)[0][0])
             raise RecordingError(f"{rec.name}: {name} has {int(bad.sum())} non-finite values (first in row {row + 1})")
-    if not (math.isfinite(rec.fs) and rec.fs > 0):
-        raise RecordingError(f"{rec.name}: sample rate must be positive, got {rec.fs!r}")
+    _check_rate(rec.name, rec.fs)
     peak = float(np.max(np.abs(rec.gyr)))
     if peak > MAX_GYRO_RAD_S:
         raise RecordingError(

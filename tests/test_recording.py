@@ -69,6 +69,21 @@ def test_a_spreadsheets_header_reads_as_ours(tmp_path, recording):
     assert sheet.fs == plain.fs and np.array_equal(sheet.gyr, plain.gyr) and np.array_equal(sheet.acc, plain.acc)
 
 
+def test_time_stamps_in_milliseconds_need_their_unit(tmp_path, recording, capsys):
+    """t in ms (10, 20, …) read as seconds is a 0.1 Hz recording: refused with the hint;
+    with --t-unit ms it is the recording in seconds."""
+    _, gyr, acc, _ = recording
+    t = np.arange(1, 1001) / FS
+    _write(tmp_path / "in.csv", t, gyr[:1000], acc[:1000])
+    seconds, _ = _estimate_csv(tmp_path, capsys)
+    _write(tmp_path / "in.csv", np.round(t * 1000), gyr[:1000], acc[:1000])
+    assert main(["estimate", str(tmp_path / "in.csv"), "--out", str(tmp_path / "o.csv")]) == 2
+    assert "a sample rate of 0.1 Hz is outside the 1–100000 Hz of IMUs; are the time stamps in seconds? " \
+           "If not, pass --t-unit (s, ms, us, ns)" in capsys.readouterr().err
+    milliseconds, _ = _estimate_csv(tmp_path, capsys, "--t-unit", "ms")
+    assert np.allclose(milliseconds, seconds, rtol=0, atol=1e-9)
+
+
 def test_missing_samples_are_filled_in_and_the_output_keeps_the_input_rows(tmp_path, recording, capsys):
     """30 runs of 1–29 dropped samples: filled in (gyro and accelerometer interpolated), the
     inclination error at the rows kept is at most 60 % of that of the same rows taken as
