@@ -49,10 +49,11 @@ from .sensor_frame import time_reversed
 from .stepper_system import sample_system
 from .wiener_local import butterworth_zoh
 
+REST_NOISE_SIGMAS = 4.5  # the least rest_gyr in units of the gyro noise's per-axis s.d. through tau_short
 PARAMS = (
     Param("rest_gyr", math.radians(2.0), "rad/s",
           "largest deviation of the gyro (through tau_short) from its low-pass at rest; at least "
-          "4.5 times delta_n's noise through tau_short"),
+          f"{REST_NOISE_SIGMAS:g} times delta_n's noise through tau_short"),
     Param("rest_gyr_abs", math.radians(5.0), "rad/s", "largest low-passed gyro norm at rest (offset included)"),
     Param("rest_acc", 0.5, "m/s²",
           "largest deviation of the accelerometer (through tau_short) from its low-pass at rest"),
@@ -82,7 +83,6 @@ STATE_NAMES = (
 T, QUAT, ACC_LP, R_LP, RB_LP, COV, SHORT = 10, slice(11, 15), slice(15, 21), slice(21, 39), slice(39, 45), slice(45, 54), 54
 OBSERVED = 0.5  # the least share of an offset's effect H must keep in a direction to update it
 CLIP_SIGMAS = 4.0  # innovations clipped at this many sigma_init
-REST_NOISE_SIGMAS = 4.5  # the least rest_gyr in units of the gyro noise's per-axis s.d. through tau_short
 SETTLE_TAUS = 3.0  # no update before this many tau_acc (the low-pass forgetting its start)
 
 
