@@ -25,6 +25,14 @@ from .stages import split_params
 IO_INPUTS = slice(0, 6)  # gyr x, y, z (rad/s), acc x, y, z (m/s²)
 IO_OUTPUTS = slice(6, 16)  # q w, x, y, z; unit up x, y, z; roll, pitch, yaw (rad)
 IO_MAG = slice(16, 19)  # magnetic field x, y, z (µT), for heading=True
+# relative difference below which two sample times are one: a master that keeps time in
+# integer nanoseconds, or sums steps in floating point, hands over Ts with rounding noise
+STEP_TOLERANCE = 1e-9
+
+
+def same_step(Ts: float, reference: float) -> bool:
+    """Whether the sample time Ts (s) is reference (s) up to STEP_TOLERANCE."""
+    return abs(Ts - reference) <= STEP_TOLERANCE * reference
 
 
 @kernel(inline=True)
@@ -123,8 +131,9 @@ class OnlineEstimator:
     def step_io(self, Ts: float) -> bool:
         """Take the sample in io[0:6] (and io[16:19] with heading; Ts in s). Returns whether
         io[6:16] holds a new estimate: False for a non-finite input (the estimate is held)
-        or before gravity was seen."""
-        if Ts != self._Ts:
+        or before gravity was seen. A Ts within STEP_TOLERANCE of the last one keeps its
+        discretisation."""
+        if self._Ts is None or not same_step(Ts, self._Ts):
             if not (math.isfinite(Ts) and Ts > 0):
                 raise ValueError(f"sample time must be a finite positive number of seconds, got {Ts!r}")
             self._stepper, self._Ts = stepper(self.method, self.params, Ts), Ts

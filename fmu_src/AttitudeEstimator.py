@@ -16,7 +16,7 @@ import math
 from fmu_support import IN, OUT, PAR, Fmi2Status, ProjectSlave, fmi_unit
 
 from blocks.methods import METHODS
-from blocks.online import OnlineEstimator
+from blocks.online import OnlineEstimator, same_step
 from blocks.stages import ESTIMATORS
 
 
@@ -58,7 +58,7 @@ class AttitudeEstimator(ProjectSlave):
         for name, (unit, doc, start) in tuning_parameters().items():
             self.real(name, start, unit, doc, PAR)
         self.estimator = None
-        self._warned_steps = set()
+        self._warned_steps = []
 
     def exit_initialization_mode(self):
         if not (math.isfinite(self.Ts) and self.Ts > 0):
@@ -83,8 +83,8 @@ class AttitudeEstimator(ProjectSlave):
             return self.refuse_step()
         if self.estimator is None:
             return self.fail("doStep before initialisation")
-        if step_size != self.Ts and step_size not in self._warned_steps:
-            self._warned_steps.add(step_size)
+        if not any(same_step(step_size, s) for s in (self.Ts, *self._warned_steps)):
+            self._warned_steps.append(step_size)
             self.log(f"communication step {step_size:g} s differs from Ts = {self.Ts:g} s: "
                      "filter re-discretised for it", Fmi2Status.warning)
         io = self.estimator.io

@@ -120,7 +120,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     vf = sub.add_parser("verify", help="co-simulate every profile with every estimator as FMUs; exit 1 if a bound is missed")
     vf.add_argument("--json", action="store_true")
-    vf.add_argument("--fmu-dir", default="dist", help="where the FMUs are, built there if missing (default dist/)")
+    vf.add_argument("--fmu-dir", default="dist", help="where the FMUs are, built there if missing or built from other sources (default dist/)")
     vf.add_argument("--rebuild", action="store_true", help="build the FMUs even if present")
     vf.add_argument("--profile", action="append", help="only this profile (repeatable)")
     vf.add_argument("--method", action="append", help="only this method (repeatable)")

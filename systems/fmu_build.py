@@ -10,6 +10,7 @@ Without a compiler the FMUs keep pythonfmu's binary, and a warning says what tha
 """
 from __future__ import annotations
 
+import hashlib
 import os
 import shlex
 import shutil
@@ -26,6 +27,29 @@ import systems
 
 FMU_NAMES = ("AttitudeEstimator", "ImuSensor", "MotionProfile")
 SOURCE_DIR = Path(fmu_src.__file__).resolve().parent
+FINGERPRINT = "resources/attitude_fmu_sources.sha256"  # in the FMU: the sources it was built from
+
+
+def source_fingerprint(name: str) -> str:
+    """SHA-256 over the sources an FMU is built from: its fmu_src module, fmu_support.py,
+    fmi2_guard.c and the packages blocks/ and systems/ (paths and contents)."""
+    digest = hashlib.sha256()
+    roots = [(SOURCE_DIR, [SOURCE_DIR / f"{name}.py", SOURCE_DIR / "fmu_support.py", SOURCE_DIR / "fmi2_guard.c"])]
+    roots += [(d, sorted(d.rglob("*.py"))) for d in (Path(p.__file__).resolve().parent for p in (blocks, systems))]
+    for root, files in roots:
+        for path in files:
+            digest.update(f"{root.name}/{path.relative_to(root).as_posix()}\0".encode())
+            digest.update(path.read_bytes())
+    return digest.hexdigest()
+
+
+def built_from(fmu) -> str | None:
+    """The source fingerprint stored in the FMU at its build; None if it has none."""
+    try:
+        with zipfile.ZipFile(fmu) as zf:
+            return zf.read(FINGERPRINT).decode().strip()
+    except (KeyError, OSError, zipfile.BadZipFile):
+        return None
 
 
 def build(out, names=FMU_NAMES) -> list[Path]:
@@ -49,9 +73,11 @@ def build(out, names=FMU_NAMES) -> list[Path]:
         finally:
             sys.path.remove(str(SOURCE_DIR))
         guard = compile_guard(Path(tmp) / "fmi2_guard.so")
-        if guard is not None:
-            for path in built:
+        for path in built:
+            if guard is not None:
                 install_guard(path, guard)
+            with zipfile.ZipFile(path, "a", zipfile.ZIP_DEFLATED) as zf:
+                zf.writestr(FINGERPRINT, source_fingerprint(path.stem) + "\n")
     return built
 
 
@@ -103,10 +129,16 @@ def install_guard(fmu: Path, guard: Path) -> None:
 
 
 def ensure_built(fmu_dir, rebuild: bool = False, log=print) -> Path:
-    """The directory holding every FMU, building those missing (or all with rebuild)."""
+    """The directory holding every FMU, building those missing or built from other sources
+    than this installation's (or all with rebuild): FMUs loaded into one process share the
+    first-loaded copy of the project's modules, so the ones run must match the code."""
     fmu_dir = Path(fmu_dir)
     missing = [n for n in FMU_NAMES if rebuild or not (fmu_dir / f"{n}.fmu").is_file()]
+    stale = [n for n in FMU_NAMES if n not in missing and built_from(fmu_dir / f"{n}.fmu") != source_fingerprint(n)]
     if missing:
         log(f"building {', '.join(missing)} into {fmu_dir}")
-        build(fmu_dir, missing)
+    if stale:
+        log(f"rebuilding {', '.join(stale)} in {fmu_dir}: built from other sources than these")
+    if missing or stale:
+        build(fmu_dir, [n for n in FMU_NAMES if n in missing or n in stale])
     return fmu_dir

@@ -3,11 +3,14 @@ from __future__ import annotations
 
 import zipfile
 from pathlib import Path
-from xml.etree.ElementTree import Element, SubElement, tostring
+from xml.etree.ElementTree import Element, SubElement, register_namespace, tostring
 
 SSD = "http://ssp-standard.org/SSP1/SystemStructureDescription"
 SSC = "http://ssp-standard.org/SSP1/SystemStructureCommon"
 SSV = "http://ssp-standard.org/SSP1/SystemStructureParameterValues"
+# the standard's own prefixes: importers that match element names literally (libcosim) need them
+for _prefix, _uri in (("ssd", SSD), ("ssc", SSC), ("ssv", SSV)):
+    register_namespace(_prefix, _uri)
 XYZ = ("x", "y", "z")
 
 # component name → (FMU, inputs, outputs)

@@ -2,9 +2,11 @@
 import json
 import math
 import os
+import shutil
 import subprocess
 import sys
 import textwrap
+import zipfile
 
 import numpy as np
 import pytest
@@ -13,10 +15,11 @@ from fmpy.ssp.simulation import simulate_ssp
 from fmpy.validation import validate_fmu
 
 from blocks.methods import METHODS
+from blocks.online import STEP_TOLERANCE, OnlineEstimator
 from systems.batch import estimate
 from systems.cosim import FmuRunner, cosimulate
 from systems.errors import inclination_error
-from systems.fmu_build import FMU_NAMES, build
+from systems.fmu_build import FINGERPRINT, FMU_NAMES, build, built_from, ensure_built, source_fingerprint
 from systems.motion import HumanMotion, profile
 from systems.sensor_model import ImuModel
 from systems.ssp import write_ssp
@@ -43,6 +46,31 @@ def recording():
 
 def _estimator(fmu_dir, **parameters):
     return FmuRunner(fmu_dir / "AttitudeEstimator.fmu", parameters, INPUTS, OUTPUTS, logging=True)
+
+
+def test_fmus_built_from_other_sources_are_rebuilt(fmu_dir, tmp_path):
+    """FMUs in one process share the first-loaded copy of the project's modules, so an FMU
+    built from other sources (an earlier version, since edited code) would run this code or
+    fail to import it. ensure_built (attitude verify) rebuilds exactly those."""
+    for name in FMU_NAMES:
+        shutil.copy(fmu_dir / f"{name}.fmu", tmp_path)
+        assert built_from(tmp_path / f"{name}.fmu") == source_fingerprint(name)
+    assert len({source_fingerprint(name) for name in FMU_NAMES}) == len(FMU_NAMES)
+    logs = []
+    ensure_built(tmp_path, log=logs.append)
+    assert logs == []
+    stale = tmp_path / "ImuSensor.fmu"  # as built before fingerprints, or from other sources
+    with zipfile.ZipFile(fmu_dir / "ImuSensor.fmu") as src, zipfile.ZipFile(stale, "w") as dst:
+        for item in src.infolist():
+            if item.filename != FINGERPRINT:
+                dst.writestr(item, src.read(item))
+    assert built_from(stale) is None
+    kept = {name: (tmp_path / f"{name}.fmu").read_bytes() for name in FMU_NAMES if name != "ImuSensor"}
+    ensure_built(tmp_path, log=logs.append)
+    assert logs == [f"rebuilding ImuSensor in {tmp_path}: built from other sources than these"]
+    assert built_from(stale) == source_fingerprint("ImuSensor")
+    assert all((tmp_path / f"{name}.fmu").read_bytes() == data for name, data in kept.items())
+    assert validate_fmu(str(stale)) == []
 
 
 def test_every_fmu_validates(fmu_dir):
@@ -169,8 +197,6 @@ def test_changed_step_size_is_rediscretised_and_logged(fmu_dir, recording, capsy
     assert "differs from Ts" in capsys.readouterr().out
     # the same as the batch path over both halves, each at its own rate, carried across
     first = estimate(gyr[:100], acc[:100], 100.0)
-    from blocks.online import OnlineEstimator
-
     online = OnlineEstimator()
     expected = []
     for k, row in enumerate(data):
@@ -178,6 +204,22 @@ def test_changed_step_size_is_rediscretised_and_logged(fmu_dir, recording, capsy
         expected.append(online.io[6:10].copy())
     assert np.abs(out[:100, :4] - first.quat).max() < 1e-9
     assert np.abs(out[:, :4] - np.array(expected)).max() < 1e-9
+
+
+def test_a_step_size_with_rounding_noise_is_ts(fmu_dir, recording, capsys):
+    """A master that keeps time in integer nanoseconds, or sums steps in floating point,
+    hands over Ts with rounding noise: the FMU keeps its discretisation and logs nothing."""
+    gyr, acc = recording
+    data = np.hstack([gyr, acc])[:200]
+    steps = 0.01 * (1.0 + 0.5 * STEP_TOLERANCE * np.sin(np.arange(len(data))))
+    assert len(set(steps.tolist())) == len(data)
+    runs = []
+    for step in (steps, np.full(len(data), 0.01)):
+        runner = _estimator(fmu_dir)
+        runs.append(np.array([runner.step(row, h)[0] for row, h in zip(data, step)]))
+        runner.close()
+    assert "differs from Ts" not in capsys.readouterr().out
+    assert (runs[0] == runs[1]).all()
 
 
 @pytest.mark.parametrize("method, name", [("wiener", "scale_error"), ("mahony", "k_I")])
@@ -394,3 +436,79 @@ def test_guard_reports_a_missing_pythonfmu_library_instead_of_crashing(fmu_dir, 
     with pytest.raises(Exception, match="instantiate"):
         slave.instantiate()
     assert f"cannot load {tmp_path / 'x'}" in capsys.readouterr().out
+
+
+
+def test_the_ssd_names_its_elements_with_the_standards_prefixes(fmu_dir, tmp_path):
+    """ssd:, ssc:, ssv: as the SSP standard writes them: libcosim's reader matches element
+    names literally and found no "ssd:SystemStructureDescription" in ElementTree's ns0:."""
+    ssp = write_ssp(tmp_path / "human.ssp", fmu_dir, {"estimator": {"method": "wiener", "Ts": 0.01}}, 1.0, 1 / FS)
+    with zipfile.ZipFile(ssp) as zf:
+        ssd = zf.read("SystemStructure.ssd").decode()
+    assert "<ssd:SystemStructureDescription " in ssd and "<ssc:Real" in ssd and "<ssv:Real " in ssd
+    assert "ns0:" not in ssd
+
+
+def _libcosim_run(ssp, stop_time: float, step: float, variables: dict[str, list[str]]) -> dict[str, np.ndarray]:
+    """Run an SSP with libcosim (Open Simulation Platform: C++, FMI Library, its own SSP
+    reader and fixed-step master); "component.variable" (Real or Boolean) → its value
+    after each step."""
+    pytest.importorskip("libcosimpy")
+    from libcosimpy.CosimEnums import CosimVariableType
+    from libcosimpy.CosimExecution import CosimExecution
+    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+    from libcosimpy.CosimObserver import CosimObserver
+
+    log_output_level(CosimLogLevel.WARNING)
+    ex = CosimExecution.from_ssp_file(str(ssp), int(round(step * 1e9)))  # step in ns
+    last = CosimObserver.create_last_value()
+    ex.add_observer(last)
+    reads = []  # (component index, reader, references, names)
+    for slave in ex.slave_infos():
+        component = slave.name.decode()
+        found = {v.name.decode(): v for v in ex.slave_variables(slave.index)}
+        for kind, reader in ((CosimVariableType.REAL, last.last_real_values),
+                             (CosimVariableType.BOOLEAN, last.last_boolean_values)):
+            names = [n for n in variables.get(component, ()) if found[n].type == kind.value]
+            if names:
+                reads.append((slave.index, reader, [found[n].reference for n in names],
+                              [f"{component}.{n}" for n in names]))
+    record = {name: [] for *_, names in reads for name in names}
+    for _ in range(int(round(stop_time / step))):
+        ex.step()
+        for index, reader, references, names in reads:
+            for name, value in zip(names, reader(index, references)):
+                record[name].append(value)
+    return {name: np.array(values) for name, values in record.items()}
+
+
+def test_libcosim_runs_the_ssp_diagram_and_its_estimator_computes_ours(fmu_dir, tmp_path):
+    """A second FMI importer, independent of fmpy: libcosim reads the SSP with its own parser,
+    loads the three FMUs with FMI Library and steps them with its own fixed-step master, in
+    which each connection delays by one step and inputs begin at their start values. The
+    motion it records is the batch path's, and the estimator's outputs are those of
+    blocks.online on the inputs libcosim handed it: its FMI calls, the SSP's parameters
+    (String and Real, not the defaults) and its step size (kept in integer nanoseconds)
+    all came through."""
+    ssp = write_ssp(tmp_path / "human.ssp", fmu_dir, {
+        "motion": {"profile": "human", "seed": 3},
+        "imu": {"delta_n": math.radians(0.1), "seed": 4, **{f"gyr_scale_{r}_{c}": GYR_SCALE[i][j]
+                                                            for i, r in enumerate("xyz") for j, c in enumerate("xyz")}},
+        "estimator": {"method": "wiener", "gyro_offset": "on", "delta_n": 0.003}}, 10.0, 1 / FS)
+    inputs = [f"{s}_{a}" for s in ("gyr", "acc", "mag") for a in "xyz"]
+    out = _libcosim_run(ssp, 10.0, 1 / FS, {"motion": [f"qt_{c}" for c in "wxyz"],
+                                            "estimator": inputs + OUTPUTS + ["valid"]})
+    motion = profile("human").motion().generate(10.0, FS, 3)
+    assert np.abs(np.column_stack([out[f"motion.qt_{c}"] for c in "wxyz"]) - motion.quat).max() < 1e-12
+
+    online = OnlineEstimator("wiener", {"delta_n": 0.003}, heading=True, gyro_offset=True)
+    received = np.column_stack([out[f"estimator.{n}"] for n in inputs])
+    expected, valid = [], []
+    for row in received:
+        online.io[0:6], online.io[16:19] = row[:6], row[6:]
+        valid.append(online.step_io(1 / FS))
+        expected.append(online.io[6:13].copy())
+    assert (out["estimator.valid"] == np.array(valid)).all() and out["estimator.valid"][2:].all()
+    estimated = np.column_stack([out[f"estimator.{n}"] for n in OUTPUTS])
+    assert np.abs(estimated - np.array(expected))[out["estimator.valid"]].max() < 1e-12
+
