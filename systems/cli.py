@@ -6,6 +6,7 @@ import json
 import os
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -142,10 +143,18 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _check_out(path) -> None:
+    """Refuse an output file whose folder does not exist, before any work is done."""
+    folder = Path(path).absolute().parent
+    if not folder.is_dir():
+        raise ValueError(f"cannot write {path}: there is no folder {folder}")
+
+
 def cmd_estimate(args) -> int:
     from .batch import estimate
     from .recording import field_norm_note, read_recording, write_estimate
 
+    _check_out(args.out)
     clock = time.perf_counter()
 
     def progress(text):  # each stage takes about 3 s per million samples
@@ -204,6 +213,7 @@ def cmd_evaluate(args) -> int:
 def cmd_plot(args) -> int:
     from .plot import plot_recording
 
+    _check_out(args.out)
     result = plot_recording(args.file, args.out, args.method, dict(args.param), args.offline,
                             args.gyro_offset == "on", args.heading == "mag", _read_options(args))
     heading = f", heading RMSE {result['heading_rmse_deg']:.2f}°" if "heading_rmse_deg" in result else ""
@@ -290,6 +300,7 @@ def cmd_bode(args) -> int:
     from .bode import plot
 
     out = args.out or f"bode_{args.method}.png"
+    _check_out(out)
     plot(args.method, out)
     print(f"attitude: wrote {out}", file=sys.stderr)
     return 0

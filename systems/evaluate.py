@@ -54,23 +54,31 @@ def evaluate(paths, method: str = "wiener", params=None, offline: bool = False, 
              read_options=None) -> dict:
     """{"recordings": {name: {label: metrics}}, "mean": {label: metrics}} over the files;
     start_in_movement (s): cut each recording to begin that long into its movement phase;
-    read_options: keyword arguments of read_recording (units, fs, max_gap). progress also
-    prints how each file was read where it matters (time stamps, no movement flag)."""
+    read_options: keyword arguments of read_recording (units, fs, max_gap). Every file is
+    read and checked first. A recording's name is its file's stem, or its path where
+    stems repeat. progress also prints how each file was read where it matters (time
+    stamps, no movement flag)."""
+    read = []  # every file read and checked before any estimate: a bad last file costs nothing
+    for path in paths:
+        rec = read_recording(path, **(read_options or {}))
+        if start_in_movement is not None:
+            rec = rec.into_movement(start_in_movement)
+        rec.evaluated()
+        if progress:
+            for note in rec.notes + ([f"{rec.name}: no movement flag; errors over every sample with a reference"]
+                                     if rec.movement is None else []):
+                print(f"attitude: note: {note}", file=sys.stderr)
+        read.append((path, rec))
+    names = [rec.name for _, rec in read]
+    if len(set(names)) < len(names):  # files of one name from several folders: keyed by path
+        names = [str(path) for path, _ in read]
     recordings = {}
-    for i, path in enumerate(paths):
+    for i, (name, (path, rec)) in enumerate(zip(names, read)):
         if progress:
             done = int(20 * i / len(paths))
             print(f"\revaluate [{'#' * done}{'.' * (20 - done)}] {i + 1}/{len(paths)} {path}",
                   end="" if sys.stderr.isatty() else "\n", file=sys.stderr, flush=True)
-        rec = read_recording(path, **(read_options or {}))
-        if progress:
-            notes = rec.notes + ([f"{rec.name}: no movement flag; errors over every sample with a reference"]
-                                 if rec.movement is None else [])
-            for note in notes:  # below the progress bar, which a terminal keeps on its line
-                print(f"{chr(10) if sys.stderr.isatty() else ''}attitude: note: {note}", file=sys.stderr)
-        if start_in_movement is not None:
-            rec = rec.into_movement(start_in_movement)
-        recordings[rec.name] = evaluate_recording(rec, method, params, offline, gyro_offset, use_mag)
+        recordings[name] = evaluate_recording(rec, method, params, offline, gyro_offset, use_mag)
     if progress and sys.stderr.isatty():
         print(file=sys.stderr)
     labels = set.intersection(*(set(r) for r in recordings.values()))  # vqf_9d needs every file's mag

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import csv
 import math
+import warnings
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -97,11 +98,14 @@ def read_recording(path, fs: float | None = None, gyr_unit: str = "rad/s", acc_u
         raise RecordingError(f"the sample rate must be a finite positive number of Hz, got {fs!r}")
     if not (math.isfinite(max_gap) and max_gap >= 0):
         raise RecordingError(f"the longest gap to fill must be a finite number of seconds ≥ 0, got {max_gap!r}")
-    rec = _read_mat(path) if path.suffix.lower() == ".mat" else _read_csv(path, fs, max_gap, T_UNITS[t_unit])
+    rec = _read_mat(path, fs) if path.suffix.lower() == ".mat" else _read_csv(path, fs, max_gap, T_UNITS[t_unit])
     if fs is not None and abs(rec.fs - fs) > 0.01 * fs:
         raise RecordingError(f"{path}: --fs {fs:g} Hz disagrees with the recording's {rec.fs:g} Hz")
     rec.gyr = rec.gyr * GYR_UNITS[gyr_unit]
     rec.acc = rec.acc * ACC_UNITS[acc_unit]
+    if rec.mag is not None and np.isnan(rec.mag).any(axis=1).all():
+        rec.mag = None
+        rec.notes.append(f"{rec.name}: the magnetometer has no sample (NaN throughout); heading from the gyro")
     if rec.mag is not None:
         rec.mag = rec.mag * MAG_UNITS[mag_unit]
     _check_values(rec)
@@ -136,14 +140,17 @@ def _read_csv(path: Path, fs: float | None, max_gap: float, t_scale: float) -> R
     missing = [c for c in IMU_COLUMNS if c not in header]
     if missing:
         raise RecordingError(f"{path}: missing columns {', '.join(missing)} (header: {','.join(header)})")
-    ref_given = [c for c in REF_COLUMNS if c in header]
-    if ref_given and len(ref_given) < len(REF_COLUMNS):
-        raise RecordingError(f"{path}: the reference needs all of {','.join(REF_COLUMNS)}, "
-                             f"the header has only {','.join(ref_given)}")
+    for group, what in ((MAG_COLUMNS, "the magnetometer"), (REF_COLUMNS, "the reference")):
+        given = [c for c in group if c in header]
+        if given and len(given) < len(group):
+            raise RecordingError(f"{path}: {what} needs all of {','.join(group)}, "
+                                 f"the header has only {','.join(given)}")
     if "t" not in header and fs is None:
         raise RecordingError(f"{path}: no 't' column; give the sample rate with --fs HZ")
     try:
-        data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2, dtype=float)
+        with warnings.catch_warnings():  # no rows: said below, not as numpy's warning
+            warnings.simplefilter("ignore", UserWarning)
+            data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2, dtype=float)
     except ValueError as exc:
         raise RecordingError(f"{path}: unreadable number ({exc})") from None
     if data.shape[0] == 0 or data.shape[1] != len(header):
@@ -155,6 +162,9 @@ def _read_csv(path: Path, fs: float | None, max_gap: float, t_scale: float) -> R
                     None if "t" not in col else col["t"] * t_scale,
                     columns(MAG_COLUMNS), columns(REF_COLUMNS),
                     None if movement is None else _flag(path, MOVEMENT_COLUMN, movement))
+    unknown = [c for c in header if c not in ("t", *IMU_COLUMNS, *MAG_COLUMNS, *REF_COLUMNS, MOVEMENT_COLUMN)]
+    if unknown:
+        rec.notes.append(f"{rec.name}: columns not read: {', '.join(unknown)}")
     if rec.t is None:
         rec.fs, rec.t = float(fs), np.arange(1, data.shape[0] + 1) / fs
         return rec
@@ -241,18 +251,20 @@ def _flag(path: Path, name: str, values) -> np.ndarray:
     return values == 1
 
 
-def _read_mat(path: Path) -> Recording:
+def _read_mat(path: Path, fs: float | None) -> Recording:
+    """A BROAD recording; without a sampling_rate variable, at fs (Hz) if given."""
     from scipy.io import loadmat
 
     try:
         mat = loadmat(path, squeeze_me=True)
     except Exception as exc:  # scipy raises several types for damaged files
         raise RecordingError(f"{path}: not a readable MATLAB file ({exc})") from None
-    missing = [k for k in ("imu_gyr", "imu_acc", "sampling_rate") if k not in mat]
+    missing = [k for k in ("imu_gyr", "imu_acc", *(() if fs else ("sampling_rate",))) if k not in mat]
     if missing:
-        raise RecordingError(f"{path}: missing variables {', '.join(missing)} (expected a BROAD recording)")
+        raise RecordingError(f"{path}: missing variables {', '.join(missing)} (expected a BROAD recording"
+                             f"{'; without sampling_rate give --fs HZ' if 'sampling_rate' in missing else ''})")
     try:
-        fs = float(mat["sampling_rate"])
+        fs = float(mat["sampling_rate"]) if "sampling_rate" in mat else fs
     except (TypeError, ValueError):
         raise RecordingError(f"{path}: sampling_rate must be one number (Hz)") from None
     gyr = np.atleast_2d(np.asarray(mat["imu_gyr"], dtype=float))
@@ -286,7 +298,8 @@ def _check_values(rec: Recording) -> None:
     for name in ("gyr", "acc"):
         a = getattr(rec, name)
         if a.ndim != 2 or a.shape[1] != 3 or len(a) != len(rec.gyr) or len(a) == 0:
-            raise RecordingError(f"{rec.name}: {name} must be N×3 with N ≥ 1, got {a.shape}")
+            hint = "; stored as 3×N? transpose it" if a.ndim == 2 and a.shape[0] == 3 else ""
+            raise RecordingError(f"{rec.name}: {name} must be N×3 with N ≥ 1, got {a.shape}{hint}")
         bad = ~np.isfinite(a)
         if bad.any():
             row = int(np.argwhere(bad)[0][0])

@@ -152,6 +152,12 @@ def test_bad_input_ends_with_a_message_and_exit_2(tmp_path, imu, capsys):
     for path in (tmp_path / "broken.mat", tmp_path / "absent.csv"):
         assert main(["estimate", str(path), "--out", str(tmp_path / "o.csv")]) == 2
         assert "attitude: error:" in capsys.readouterr().err
+    # an output folder that does not exist is refused before the input is read
+    _write_csv(tmp_path / "good.csv", _imu_columns(*imu))
+    for command in (["estimate", str(tmp_path / "good.csv")], ["plot", str(tmp_path / "good.csv"), "--method", "wiener"]):
+        assert main([*command, "--out", str(tmp_path / "absent" / "o.csv")]) == 2
+        err = capsys.readouterr().err
+        assert f"there is no folder {tmp_path / 'absent'}" in err and "attitude: read" not in err, err
 
 
 def test_console_entry_point_reports_errors_without_traceback(tmp_path):

@@ -3,6 +3,7 @@
 benchmark, tests/test_broad_benchmark.py, that skips without the files)."""
 import json
 import math
+import shutil
 
 import numpy as np
 import pytest
@@ -276,6 +277,12 @@ def test_evaluate_json_contract_on_synthetic_recordings(tmp_path, capsys):
     assert json.loads(capsys.readouterr().out)["recordings"]["a"] == evaluate_recording(cut)
     assert main(["evaluate", "--start-in-movement", "100", str(tmp_path / "a.mat")]) == 2
     assert "ends before 100 s into its movement phase" in capsys.readouterr().err
+    # files of one name from two folders are told apart by their paths
+    (tmp_path / "x").mkdir()
+    shutil.copy(tmp_path / "a.mat", tmp_path / "x" / "a.mat")
+    paths = [str(tmp_path / "a.mat"), str(tmp_path / "x" / "a.mat")]
+    assert main(["evaluate", "--json", *paths]) == 0
+    assert list(json.loads(capsys.readouterr().out)["recordings"]) == paths
 
 
 @pytest.mark.parametrize("case", ["no optical reference", "no valid sample during movement", "not a readable"])
@@ -291,9 +298,11 @@ def test_evaluate_without_reference_or_on_a_broken_file_fails_cleanly(tmp_path, 
             data = loadmat(path)
             savemat(path, {**{k: v for k, v in data.items() if not k.startswith("__")},
                            "opt_quat": np.full_like(data["opt_quat"], np.nan)})
-    assert main(["evaluate", str(path)]) == 2
+    _broad_like(tmp_path / "good.mat", motion)
+    assert main(["evaluate", str(tmp_path / "good.mat"), str(path)]) == 2
     err = capsys.readouterr().err
     assert "attitude: error:" in err and case in err and "Traceback" not in err, err
+    assert "evaluate [" not in err  # every file is checked before the first is estimated
 
 
 def test_quaternion_errors_split_heading_from_inclination():

@@ -2,6 +2,7 @@
 reference orientation in a CSV, evaluated as a BROAD .mat is."""
 import json
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -67,6 +68,50 @@ def test_a_spreadsheets_header_reads_as_ours(tmp_path, recording):
     (tmp_path / "sheet.csv").write_text("\n".join([header, *lines[1:]]) + "\n", encoding="utf-8")
     plain, sheet = read_recording(tmp_path / "plain.csv"), read_recording(tmp_path / "sheet.csv")
     assert sheet.fs == plain.fs and np.array_equal(sheet.gyr, plain.gyr) and np.array_equal(sheet.acc, plain.acc)
+
+
+def test_columns_it_cannot_use_are_refused_or_named(tmp_path, recording, capsys):
+    """A magnetometer with an axis missing is refused, as a partial reference is; columns
+    it does not know (a capitalised name, a temperature) are named on standard error, not
+    silently dropped; a header without rows is refused in one message."""
+    _, gyr, acc, _ = recording
+    t = np.arange(1, 101) / FS
+    field = {f"mag_{a}": np.full(100, v) for a, v in zip("xy", (20.0, -40.0))}
+    _write(tmp_path / "in.csv", t, gyr[:100], acc[:100], field)
+    assert main(["estimate", str(tmp_path / "in.csv"), "--out", str(tmp_path / "out.csv")]) == 2
+    err = capsys.readouterr().err
+    assert "the magnetometer needs all of mag_x,mag_y,mag_z, the header has only mag_x,mag_y" in err, err
+    _write(tmp_path / "in.csv", t, gyr[:100], acc[:100], {"mag_X": np.ones(100), "temp": np.ones(100)})
+    plain, _ = _estimate_csv(tmp_path, capsys)
+    assert "columns not read: mag_X, temp" in _estimate_csv(tmp_path, capsys)[1]
+    _write(tmp_path / "in.csv", t, gyr[:100], acc[:100])
+    assert np.array_equal(_estimate_csv(tmp_path, capsys)[0], plain)
+    (tmp_path / "in.csv").write_text("t," + ",".join(IMU_COLUMNS) + "\n")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert main(["estimate", str(tmp_path / "in.csv"), "--out", str(tmp_path / "out.csv")]) == 2
+    assert "expected 7 columns of numbers and at least one row" in capsys.readouterr().err
+
+
+def test_mat_files_with_a_transposed_array_no_rate_or_no_magnetometer_sample(tmp_path, recording, capsys):
+    """A 3×N array is refused with the hint to transpose it; a file without sampling_rate
+    reads at --fs; a magnetometer that is NaN throughout is noted and left out (6D), as
+    --heading gyro would, instead of ending the run."""
+    _, gyr, acc, _ = recording
+    gyr, acc = gyr[:1000], acc[:1000]
+    savemat(tmp_path / "t.mat", {"imu_gyr": gyr.T, "imu_acc": acc.T, "sampling_rate": FS})
+    assert main(["estimate", str(tmp_path / "t.mat"), "--out", str(tmp_path / "o.csv")]) == 2
+    assert "gyr must be N×3 with N ≥ 1, got (3, 1000); stored as 3×N? transpose it" in capsys.readouterr().err
+    savemat(tmp_path / "ref.mat", {"imu_gyr": gyr, "imu_acc": acc, "sampling_rate": FS})
+    savemat(tmp_path / "in.mat", {"imu_gyr": gyr, "imu_acc": acc, "imu_mag": np.full_like(gyr, np.nan)})
+    assert main(["estimate", str(tmp_path / "in.mat"), "--out", str(tmp_path / "o.csv")]) == 2
+    assert "missing variables sampling_rate" in capsys.readouterr().err
+    outputs = []
+    for name, flags in (("in", ["--fs", str(FS)]), ("ref", ["--heading", "gyro"])):
+        assert main(["estimate", str(tmp_path / f"{name}.mat"), "--out", str(tmp_path / f"{name}.csv"), *flags]) == 0
+        outputs.append((np.loadtxt(tmp_path / f"{name}.csv", delimiter=",", skiprows=1), capsys.readouterr().err))
+    assert np.array_equal(outputs[0][0], outputs[1][0])
+    assert "the magnetometer has no sample (NaN throughout); heading from the gyro" in outputs[0][1]
 
 
 def test_time_stamps_in_milliseconds_need_their_unit(tmp_path, recording, capsys):
