@@ -60,7 +60,7 @@ class AttitudeEstimator(ProjectSlave):
         self.estimator = None
         self._warned_steps = []
 
-    def exit_initialization_mode(self):
+    def initialise(self):
         if not (math.isfinite(self.Ts) and self.Ts > 0):
             self.fail(f"invalid parameter: Ts must be a finite positive number of seconds, got {self.Ts!r}")
             return

@@ -37,7 +37,7 @@ class ImuSensor(ProjectSlave):
         self.parameter("seed", 1, "seed of the noise generator", Integer)
         self.model = None
 
-    def exit_initialization_mode(self):
+    def initialise(self):
         try:
             self.model = ImuModel(
                 delta_n=self.delta_n, acc_noise=self.acc_noise,

@@ -32,7 +32,7 @@ class MotionProfile(ProjectSlave):
                 self.real(f"{prof.name}_{p.name}", 0.0, fmi_unit(p.unit), f"{prof.name}: {p.doc}; 0: default {p.default:g}", PAR)
         self.stream = None
 
-    def exit_initialization_mode(self):
+    def initialise(self):
         try:
             prof = profile(self.profile)
             overrides = {p.name: getattr(self, f"{prof.name}_{p.name}") for p in prof.params}

@@ -10,7 +10,7 @@ from AttitudeEstimator import AttitudeEstimator
 class NoOpEstimator(AttitudeEstimator):
     description = "AttitudeEstimator's interface; doStep does nothing (benchmark baseline)"
 
-    def exit_initialization_mode(self):
+    def initialise(self):
         pass
 
     def do_step(self, current_time, step_size):

@@ -6,6 +6,9 @@ variables onto them.
 """
 from __future__ import annotations
 
+import hashlib
+import sys
+from pathlib import Path
 from xml.etree.ElementTree import Element, SubElement
 
 from pythonfmu import Boolean, Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Integer, Real, String
@@ -32,6 +35,34 @@ UNITS = {
 
 
 IN, OUT, PAR = Fmi2Causality.input, Fmi2Causality.output, Fmi2Causality.parameter
+PROJECT_PACKAGES = ("blocks", "systems")  # carried in every FMU's resources
+
+
+def code_digest(root) -> str:
+    """SHA-256 over the project's packages under the folder root: the relative paths and
+    contents of their .py files."""
+    root = Path(root)
+    digest = hashlib.sha256()
+    for package in PROJECT_PACKAGES:
+        for path in sorted((root / package).rglob("*.py")):
+            digest.update(f"{path.relative_to(root).as_posix()}\0".encode())
+            digest.update(path.read_bytes())
+    return digest.hexdigest()
+
+
+def foreign_code(resources) -> str | None:
+    """Why an FMU whose resources folder is resources cannot run in this process, or None.
+    Python keeps one copy of a module per process: if the project's packages were imported
+    before this FMU from other sources (another FMU's build, an installed version of the
+    project), the FMU would run that code."""
+    loaded = sys.modules.get(PROJECT_PACKAGES[0])
+    if resources is None or loaded is None:
+        return None
+    source = Path(loaded.__file__).resolve().parent.parent
+    if source == Path(resources).resolve() or code_digest(source) == code_digest(resources):
+        return None
+    return (f"this FMU's code differs from the attitude-fmu code this process imported before it, from {source}; "
+            "a process holds one copy of it: run FMUs of one build together, or each in a process of its own")
 
 
 def fmi_unit(unit: str) -> str:
@@ -58,7 +89,21 @@ class UnitReal(Real):
 
 
 class ProjectSlave(Fmi2Slave):
-    """Fmi2Slave with units and helpers; subclasses register their variables."""
+    """Fmi2Slave with units and helpers; subclasses register their variables and build
+    their model from the parameters in initialise()."""
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.error = foreign_code(self.resources)
+
+    def exit_initialization_mode(self):
+        if self.error is not None:
+            self.fail(self.error)
+            return
+        self.initialise()
+
+    def initialise(self):
+        """Build the model from the parameters; an invalid one: fail(message)."""
 
     def to_xml(self, model_options=None) -> Element:
         root = super().to_xml(model_options or {})
@@ -96,7 +141,7 @@ class ProjectSlave(Fmi2Slave):
         self.register_variable(Boolean(name, causality=Fmi2Causality.output, variability=Fmi2Variability.discrete,
                                        initial=Fmi2Initial.exact, description=description), nested=False)
 
-    error = None  # the message of an invalid configuration, once one was found
+    error = None  # the message of an invalid configuration or of foreign code, once one was found
 
     def fail(self, message: str) -> bool:
         """Log an error and remember it; every later doStep logs it again.

@@ -24,6 +24,7 @@ from pathlib import Path
 import blocks
 import fmu_src
 import systems
+from fmu_src.fmu_support import code_digest
 
 FMU_NAMES = ("AttitudeEstimator", "ImuSensor", "MotionProfile")
 SOURCE_DIR = Path(fmu_src.__file__).resolve().parent
@@ -32,14 +33,12 @@ FINGERPRINT = "resources/attitude_fmu_sources.sha256"  # in the FMU: the sources
 
 def source_fingerprint(name: str) -> str:
     """SHA-256 over the sources an FMU is built from: its fmu_src module, fmu_support.py,
-    fmi2_guard.c and the packages blocks/ and systems/ (paths and contents)."""
+    fmi2_guard.c and the packages blocks/ and systems/ (fmu_support.code_digest)."""
     digest = hashlib.sha256()
-    roots = [(SOURCE_DIR, [SOURCE_DIR / f"{name}.py", SOURCE_DIR / "fmu_support.py", SOURCE_DIR / "fmi2_guard.c"])]
-    roots += [(d, sorted(d.rglob("*.py"))) for d in (Path(p.__file__).resolve().parent for p in (blocks, systems))]
-    for root, files in roots:
-        for path in files:
-            digest.update(f"{root.name}/{path.relative_to(root).as_posix()}\0".encode())
-            digest.update(path.read_bytes())
+    for path in (SOURCE_DIR / f"{name}.py", SOURCE_DIR / "fmu_support.py", SOURCE_DIR / "fmi2_guard.c"):
+        digest.update(f"{path.name}\0".encode())
+        digest.update(path.read_bytes())
+    digest.update(code_digest(Path(blocks.__file__).resolve().parent.parent).encode())
     return digest.hexdigest()
 
 

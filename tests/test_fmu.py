@@ -253,6 +253,23 @@ def test_invalid_parameter_ends_initialisation_in_fmi2_error(fmu_dir, parameters
     assert "[ERROR] invalid parameter" in log and message in log, log
 
 
+def test_an_fmu_of_other_code_than_the_process_has_loaded_ends_initialisation_in_fmi2_error(fmu_dir, tmp_path, capsys):
+    """This process imported the project before the FMU (as a script using the library
+    does, or an FMU of another build loaded first); Python keeps that one copy, so an FMU
+    whose own code differs would run code it was not built from. It says so instead; an
+    FMU of the same code runs (every other test here)."""
+    other = tmp_path / "AttitudeEstimator.fmu"
+    with zipfile.ZipFile(fmu_dir / "AttitudeEstimator.fmu") as src, zipfile.ZipFile(other, "w") as dst:
+        for item in src.infolist():
+            data = src.read(item)
+            dst.writestr(item, data + b"# another build\n" if item.filename == "resources/blocks/online.py" else data)
+    with pytest.raises(FMICallException) as info:
+        FmuRunner(other, {}, INPUTS, OUTPUTS, logging=False)
+    assert info.value.status == 3  # fmi2Error
+    log = capsys.readouterr().out
+    assert "[ERROR] this FMU's code differs from the attitude-fmu code this process imported before it" in log, log
+
+
 @pytest.mark.parametrize("name, parameters, message", [
     ("ImuSensor", {"delta_n": -1.0}, "delta_n"),
     ("ImuSensor", {"seed": -3}, "negative"),
