@@ -53,7 +53,8 @@ class AttitudeEstimator(ProjectSlave):
         self.boolean_output("valid", False, "an estimate is available and the last inputs were finite")
         self.parameter("method", "wiener", f"estimator: {', '.join(METHODS)}")
         self.parameter("heading", "mag", "heading source: mag (magnetometer, hard iron fitted, guarded against disturbances) or gyro")
-        self.parameter("gyro_offset", "off", "on: estimate and remove the gyro offset (at rest and while moving); off")
+        self.parameter("gyro_offset", "on", "on (default, as attitude estimate): estimate and remove the gyro offset "
+                       "(at rest and while moving); off: for a gyro without offset")
         self.real("Ts", 0.01, "s", "sample time the estimator expects (other step sizes are re-discretised)", PAR)
         for name, (unit, doc, start) in tuning_parameters().items():
             self.real(name, start, unit, doc, PAR)

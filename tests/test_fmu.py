@@ -45,7 +45,9 @@ def recording():
 
 
 def _estimator(fmu_dir, **parameters):
-    return FmuRunner(fmu_dir / "AttitudeEstimator.fmu", parameters, INPUTS, OUTPUTS, logging=True)
+    """The estimator FMU without gyro-offset estimation (the batch path's default) unless told."""
+    return FmuRunner(fmu_dir / "AttitudeEstimator.fmu", {"gyro_offset": "off", **parameters}, INPUTS, OUTPUTS,
+                     logging=True)
 
 
 def test_fmus_built_from_other_sources_are_rebuilt(fmu_dir, tmp_path):
@@ -96,7 +98,8 @@ def test_estimator_fmu_heading_from_its_magnetometer_inputs_equals_the_batch_pat
     gyr, acc = ImuModel(delta_n=math.radians(0.05), gyr_offset=(0.0, 0.0, 0.01)).apply(motion, seed=3)
     mag = motion.mag.copy()
     mag[1::3] = np.nan  # a magnetometer at a third of the rate: NaN between its samples
-    runner = FmuRunner(fmu_dir / "AttitudeEstimator.fmu", {}, INPUTS + ["mag_x", "mag_y", "mag_z"], OUTPUTS)
+    runner = FmuRunner(fmu_dir / "AttitudeEstimator.fmu", {"gyro_offset": "off"}, INPUTS + ["mag_x", "mag_y", "mag_z"],
+                       OUTPUTS)
     out, _ = runner.run(np.hstack([gyr, acc, mag]), 1 / FS)
     runner.close()
     ref = estimate(gyr, acc, FS, mag=mag)
@@ -114,7 +117,7 @@ def test_estimator_fmu_reports_the_hard_iron_estimate_of_the_batch_path(fmu_dir)
     motion, gyr, acc, mag = _turns_with_field()
     n = int(150 * FS)
     gyr, acc, mag = gyr[:n], acc[:n], mag[:n] + [15.0, -5.0, 8.0]
-    runner = FmuRunner(fmu_dir / "AttitudeEstimator.fmu", {}, INPUTS + ["mag_x", "mag_y", "mag_z"],
+    runner = FmuRunner(fmu_dir / "AttitudeEstimator.fmu", {"gyro_offset": "off"}, INPUTS + ["mag_x", "mag_y", "mag_z"],
                        OUTPUTS + ["mag_offset_x", "mag_offset_y", "mag_offset_z"])
     out, _ = runner.run(np.hstack([gyr, acc, mag]), 1 / FS)
     runner.close()
@@ -329,7 +332,8 @@ GYR_SCALE = ((0.002, 0.01, 0.0), (0.0, -0.003, 0.0), (-0.005, 0.0, 0.004))  # sc
 def _batch_pipeline(duration, seed_motion, seed_imu, delta_n, method="wiener"):
     motion = profile("human").motion().generate(duration, FS, seed_motion)
     gyr, acc = ImuModel(delta_n=delta_n, gyr_scale=GYR_SCALE).apply(motion, seed_imu)
-    return motion, estimate(gyr, acc, FS, method, mag=motion.mag)  # the sensor passes the field on
+    # the sensor passes the field on; the estimator FMU's default estimates the gyro offset
+    return motion, estimate(gyr, acc, FS, method, mag=motion.mag, gyro_offset=True)
 
 
 @pytest.mark.parametrize("method", sorted(METHODS))
@@ -400,7 +404,7 @@ def test_fmu_runs_in_a_fresh_environment_without_the_project(fmu_dir, recording,
     proc = subprocess.run([str(python), "-c", script], capture_output=True, text=True, cwd=tmp_path, env=env)
     assert proc.returncode == 0, proc.stderr[-2000:]
     out = np.array(json.loads(proc.stdout.strip().splitlines()[-1]))
-    ref = estimate(gyr[:200], acc[:200], FS)
+    ref = estimate(gyr[:200], acc[:200], FS, gyro_offset=True)  # the FMU's default
     assert np.abs(out[:, :4] - ref.quat).max() < 1e-9
     assert np.abs(out[:, 4:] - ref.up).max() < 1e-9
 
@@ -511,14 +515,14 @@ def test_libcosim_runs_the_ssp_diagram_and_its_estimator_computes_ours(fmu_dir, 
         "motion": {"profile": "human", "seed": 3},
         "imu": {"delta_n": math.radians(0.1), "seed": 4, **{f"gyr_scale_{r}_{c}": GYR_SCALE[i][j]
                                                             for i, r in enumerate("xyz") for j, c in enumerate("xyz")}},
-        "estimator": {"method": "wiener", "gyro_offset": "on", "delta_n": 0.003}}, 10.0, 1 / FS)
+        "estimator": {"method": "wiener", "heading": "gyro", "delta_n": 0.003}}, 10.0, 1 / FS)
     inputs = [f"{s}_{a}" for s in ("gyr", "acc", "mag") for a in "xyz"]
     out = _libcosim_run(ssp, 10.0, 1 / FS, {"motion": [f"qt_{c}" for c in "wxyz"],
                                             "estimator": inputs + OUTPUTS + ["valid"]})
     motion = profile("human").motion().generate(10.0, FS, 3)
     assert np.abs(np.column_stack([out[f"motion.qt_{c}"] for c in "wxyz"]) - motion.quat).max() < 1e-12
 
-    online = OnlineEstimator("wiener", {"delta_n": 0.003}, heading=True, gyro_offset=True)
+    online = OnlineEstimator("wiener", {"delta_n": 0.003}, heading=False, gyro_offset=True)
     received = np.column_stack([out[f"estimator.{n}"] for n in inputs])
     expected, valid = [], []
     for row in received:
