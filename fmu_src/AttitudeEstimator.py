@@ -59,7 +59,7 @@ class AttitudeEstimator(ProjectSlave):
         for name, (unit, doc, start) in tuning_parameters().items():
             self.real(name, start, unit, doc, PAR)
         self.estimator = None
-        self._warned_steps = []
+        self._warned_step = False
 
     def initialise(self):
         if not (math.isfinite(self.Ts) and self.Ts > 0):
@@ -84,10 +84,10 @@ class AttitudeEstimator(ProjectSlave):
             return self.refuse_step()
         if self.estimator is None:
             return self.fail("doStep before initialisation")
-        if not any(same_step(step_size, s) for s in (self.Ts, *self._warned_steps)):
-            self._warned_steps.append(step_size)
-            self.log(f"communication step {step_size:g} s differs from Ts = {self.Ts:g} s: "
-                     "filter re-discretised for it", Fmi2Status.warning)
+        if not self._warned_step and not same_step(step_size, self.Ts):
+            self._warned_step = True  # a master with variable steps would log every one
+            self.log(f"communication step {step_size:g} s differs from Ts = {self.Ts:g} s: filter re-discretised "
+                     "for it (and, without further warnings, for every other step size)", Fmi2Status.warning)
         io = self.estimator.io
         io[0], io[1], io[2] = self.gyr_x, self.gyr_y, self.gyr_z
         io[3], io[4], io[5] = self.acc_x, self.acc_y, self.acc_z
