@@ -36,6 +36,7 @@ UNITS = {
 
 IN, OUT, PAR = Fmi2Causality.input, Fmi2Causality.output, Fmi2Causality.parameter
 PROJECT_PACKAGES = ("blocks", "systems")  # carried in every FMU's resources
+_loaded_digests: dict[Path, str] = {}  # folder this process's project code came from → its code_digest
 
 
 def code_digest(root) -> str:
@@ -54,12 +55,17 @@ def foreign_code(resources) -> str | None:
     """Why an FMU whose resources folder is resources cannot run in this process, or None.
     Python keeps one copy of a module per process: if the project's packages were imported
     before this FMU from other sources (another FMU's build, an installed version of the
-    project), the FMU would run that code."""
+    project), the FMU would run that code. The loaded copy's digest is taken the first time
+    (an importer may delete an FMU's folder when it is done with it)."""
     loaded = sys.modules.get(PROJECT_PACKAGES[0])
     if resources is None or loaded is None:
         return None
     source = Path(loaded.__file__).resolve().parent.parent
-    if source == Path(resources).resolve() or code_digest(source) == code_digest(resources):
+    if source not in _loaded_digests:
+        if not (source / PROJECT_PACKAGES[0]).is_dir():
+            return None  # gone before anything could compare with it
+        _loaded_digests[source] = code_digest(source)
+    if _loaded_digests[source] == code_digest(resources):
         return None
     return (f"this FMU's code differs from the attitude-fmu code this process imported before it, from {source}; "
             "a process holds one copy of it: run FMUs of one build together, or each in a process of its own")
