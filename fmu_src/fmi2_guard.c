@@ -11,6 +11,12 @@
  *     logged an error at least fmi2Error (the model logs, never raises: fmu_support.fail);
  *   - warnings and errors always reach the importer's logger; messages of status fmi2OK only
  *     with debug logging on, filtered by the categories of fmi2SetDebugLogging.
+ *
+ * pythonfmu's library expects the host process to run Python (as fmpy or libcosimpy do).
+ * In a host without it (most FMI tools), this library first loads the libpython the FMU
+ * was built with (PYTHON_ENVIRONMENT in its resources: the library's path, its soname as a
+ * fallback, and the build environment's package folders) and starts the interpreter with
+ * those folders on sys.path.
  */
 #define _GNU_SOURCE
 #include <dlfcn.h>
@@ -21,6 +27,7 @@
 #include <string.h>
 
 #define PYTHONFMU_LIBRARY "pythonfmu-export.so"
+#define PYTHON_ENVIRONMENT "python_environment.txt" /* lines: libpython path, its soname, sys.path list */
 
 /* FMI 2.0 types (fmi2TypesPlatform.h, fmi2FunctionTypes.h) */
 typedef void *fmi2Component;
@@ -102,6 +109,60 @@ static struct {
 static const char *load_error = "not loaded";
 static pthread_once_t load_once = PTHREAD_ONCE_INIT;
 
+/* read a line of f into line (without its newline); 0 at the end of the file */
+static int read_line(FILE *f, char *line, size_t size) {
+    if (!fgets(line, (int)size, f)) return 0;
+    line[strcspn(line, "\r\n")] = '\0';
+    return 1;
+}
+
+/* Python in this process, started from the FMU's record of its build environment if the
+ * host has none; NULL, or why not (in message) */
+static const char *start_python(const char *binaries, char *message, size_t size) {
+    if (dlsym(RTLD_DEFAULT, "Py_IsInitialized")) return NULL; /* the host runs Python: pythonfmu uses it */
+    char file[4096], library[4096], soname[256], paths[16384];
+    snprintf(file, sizeof file, "%s/../../resources/" PYTHON_ENVIRONMENT, binaries);
+    FILE *f = fopen(file, "r");
+    if (!f) {
+        snprintf(message, size, "no Python in this process, and no %s to start one from", file);
+        return message;
+    }
+    int complete = read_line(f, library, sizeof library) && read_line(f, soname, sizeof soname) &&
+                   read_line(f, paths, sizeof paths);
+    fclose(f);
+    if (!complete) {
+        snprintf(message, size, "%s is incomplete", file);
+        return message;
+    }
+    void *py = library[0] ? dlopen(library, RTLD_NOW | RTLD_GLOBAL) : NULL;
+    if (!py && soname[0]) py = dlopen(soname, RTLD_NOW | RTLD_GLOBAL);
+    if (!py) {
+        snprintf(message, size, "no Python in this process, and neither %s nor %s loads (%s): install that Python "
+                 "with numpy, scipy and control, or start the importer with its libpython preloaded",
+                 library[0] ? library : "(no shared libpython at the build)", soname[0] ? soname : "-", dlerror());
+        return message;
+    }
+    int (*initialized)(void) = (int (*)(void))dlsym(py, "Py_IsInitialized");
+    void (*initialize)(int) = (void (*)(int))dlsym(py, "Py_InitializeEx");
+    int (*run)(const char *) = (int (*)(const char *))dlsym(py, "PyRun_SimpleString");
+    void *(*release)(void) = (void *(*)(void))dlsym(py, "PyEval_SaveThread");
+    if (!initialized || !initialize || !run || !release) {
+        snprintf(message, size, "%s lacks the Python C API", library);
+        return message;
+    }
+    if (!initialized()) {
+        static char code[16500];
+        initialize(0);
+        snprintf(code, sizeof code, "import sys\nsys.path[:0] = [p for p in %s if p not in sys.path]\n", paths);
+        if (run(code) != 0) {
+            snprintf(message, size, "cannot put the build environment's packages on sys.path (%s)", file);
+            return message;
+        }
+        release(); /* the GIL: pythonfmu takes it in every call, from whichever thread */
+    }
+    return NULL;
+}
+
 static void load_inner(void) {
     static char path[4096], message[4352];
     Dl_info self;
@@ -111,6 +172,8 @@ static void load_inner(void) {
     }
     const char *slash = strrchr(self.dli_fname, '/');
     int dir = slash ? (int)(slash - self.dli_fname) : 0;
+    snprintf(path, sizeof path, "%.*s", dir, self.dli_fname);
+    if ((load_error = start_python(slash ? path : ".", message, sizeof message))) return;
     snprintf(path, sizeof path, "%.*s%s" PYTHONFMU_LIBRARY, dir, self.dli_fname, slash ? "/" : "");
     /* never unloaded: pythonfmu finalises its embedded Python when its library goes */
     void *lib = dlopen(path, RTLD_NOW | RTLD_LOCAL | RTLD_NODELETE);

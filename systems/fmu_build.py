@@ -5,15 +5,18 @@ resources, so it runs where only numpy, scipy, control and pythonfmu are install
 
 On Linux (and macOS, not yet tried there) the FMU's binary is fmu_src/fmi2_guard.c,
 compiled here with the C compiler ($CC, else Python's, else cc); it loads pythonfmu's library from beside it and
-gives the FMI status codes their meaning (a logged error ends the call in fmi2Error).
+gives the FMI status codes their meaning (a logged error ends the call in fmi2Error); in an
+importer without Python it first starts the interpreter recorded by python_environment.
 Without a compiler the FMUs keep pythonfmu's binary, and a warning says what that costs.
 """
 from __future__ import annotations
 
 import hashlib
+import json
 import os
 import shlex
 import shutil
+import site
 import subprocess
 import sys
 import sysconfig
@@ -29,6 +32,7 @@ from fmu_src.fmu_support import code_digest
 FMU_NAMES = ("AttitudeEstimator", "ImuSensor", "MotionProfile")
 SOURCE_DIR = Path(fmu_src.__file__).resolve().parent
 FINGERPRINT = "resources/attitude_fmu_sources.sha256"  # in the FMU: the sources it was built from
+PYTHON_ENVIRONMENT = "resources/python_environment.txt"  # in the FMU: see python_environment
 
 
 def source_fingerprint(name: str) -> str:
@@ -40,6 +44,19 @@ def source_fingerprint(name: str) -> str:
         digest.update(path.read_bytes())
     digest.update(code_digest(Path(blocks.__file__).resolve().parent.parent).encode())
     return digest.hexdigest()
+
+
+def python_environment() -> str:
+    """What fmi2_guard.c starts Python from in a host without it: the path of this
+    interpreter's shared libpython, its soname (looked up on the library path where the
+    path does not exist), and the folders of this environment's packages as a list
+    literal (put first on sys.path). Empty lines where Python was built without a shared
+    library."""
+    shared = bool(sysconfig.get_config_var("Py_ENABLE_SHARED"))
+    soname = sysconfig.get_config_var("INSTSONAME") or "" if shared else ""
+    library = Path(sysconfig.get_config_var("LIBDIR") or "") / soname if soname else None
+    folders = [p for p in dict.fromkeys(site.getsitepackages() + [site.getusersitepackages()]) if Path(p).is_dir()]
+    return f"{library if library and library.is_file() else ''}\n{soname}\n{json.dumps(folders)}\n"
 
 
 def built_from(fmu) -> str | None:
@@ -77,6 +94,7 @@ def build(out, names=FMU_NAMES) -> list[Path]:
                 install_guard(path, guard)
             with zipfile.ZipFile(path, "a", zipfile.ZIP_DEFLATED) as zf:
                 zf.writestr(FINGERPRINT, source_fingerprint(path.stem) + "\n")
+                zf.writestr(PYTHON_ENVIRONMENT, python_environment())
     return built
 
 

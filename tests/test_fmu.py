@@ -7,6 +7,7 @@ import subprocess
 import sys
 import textwrap
 import zipfile
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -415,6 +416,37 @@ def test_fmu_runs_in_a_fresh_environment_without_the_project(fmu_dir, recording,
     ref = estimate(gyr[:200], acc[:200], FS, gyro_offset=True)  # the FMU's default
     assert np.abs(out[:, :4] - ref.quat).max() < 1e-9
     assert np.abs(out[:, 4:] - ref.up).max() < 1e-9
+
+
+def test_fmu_runs_in_an_importer_without_python(fmu_dir, tmp_path):
+    """Most FMI tools are C or C++ programs with no Python in their process, where
+    pythonfmu's library cannot load (undefined Python symbols). The FMU's binary loads the
+    libpython it was built with and starts the interpreter with the build environment's
+    packages (fmu_build.python_environment); a C importer (tests/fmi_host.c) then gets the
+    estimate blocks.online computes from the same inputs."""
+    from fmpy import extract, read_model_description
+
+    cc = os.environ.get("CC") or "cc"
+    if shutil.which(cc) is None:
+        pytest.skip("no C compiler")
+    host = tmp_path / "fmi_host"
+    subprocess.run([cc, "-O1", "-o", str(host), os.path.join(os.path.dirname(__file__), "fmi_host.c"), "-ldl"],
+                   check=True)
+    fmu = fmu_dir / "AttitudeEstimator.fmu"
+    md = read_model_description(str(fmu))
+    unzipped = Path(extract(str(fmu), unzipdir=str(tmp_path / "unzipped")))
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    u = [0.3, -0.1, 0.05, 1.0, 2.0, 9.5]
+    args = [str(host), str(unzipped / "binaries" / "linux64" / "AttitudeEstimator.so"), md.guid,
+            (unzipped / "resources").as_uri(), "300", str(1 / FS), *(str(vr[n]) for n in INPUTS), "--",
+            *(repr(v) for v in u), "--", *(str(vr[n]) for n in OUTPUTS)]
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME", "VIRTUAL_ENV")}
+    proc = subprocess.run(args, capture_output=True, text=True, env=env)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    online = OnlineEstimator(gyro_offset=True)  # the FMU's default
+    for _ in range(300):
+        online.step(u[:3], u[3:], 1 / FS)
+    assert np.abs(np.array(proc.stdout.split(), dtype=float) - online.io[6:13]).max() < 1e-9
 
 
 def test_verify_cli_json_contract_and_exit_status(fmu_dir, monkeypatch, capsys):

@@ -1,0 +1,85 @@
+/* fmi_host.c: a minimal FMI 2.0 co-simulation importer with no Python in its process, as
+ * most FMI tools are (tests/test_fmu.py). Usage:
+ *   fmi_host BINARY GUID RESOURCE_URI STEPS H VR_IN... -- U... -- VR_OUT...
+ * sets the inputs VR_IN to U before each of STEPS doSteps of H seconds, then prints the
+ * outputs VR_OUT, one per line. It ends with _exit: pythonfmu's library finalises its
+ * interpreter from a destructor that can crash at process exit. */
+#include <dlfcn.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+typedef void *Component;
+typedef struct {
+    void (*logger)(void *, const char *, int, const char *, const char *, ...);
+    void *(*allocate)(size_t, size_t);
+    void (*release)(void *);
+    void (*step_finished)(void *, int);
+    void *environment;
+} Callbacks;
+
+static void logger(void *env, const char *name, int status, const char *category, const char *message, ...) {
+    va_list args;
+    va_start(args, message);
+    fprintf(stderr, "[%d %s] ", status, category);
+    vfprintf(stderr, message, args);
+    fputc('\n', stderr);
+    va_end(args);
+}
+
+typedef Component (*Instantiate)(const char *, int, const char *, const char *, const Callbacks *, int, int);
+typedef int (*Setup)(Component, int, double, double, int, double);
+typedef int (*Mode)(Component);
+typedef int (*SetReal)(Component, const unsigned *, size_t, const double *);
+typedef int (*GetReal)(Component, const unsigned *, size_t, double *);
+typedef int (*DoStep)(Component, double, double, int);
+typedef void (*Free)(Component);
+#define CALL(type, name) type name = (type)dlsym(lib, #name)
+
+int main(int argc, char **argv) {
+    if (argc < 6) return 2;
+    void *lib = dlopen(argv[1], RTLD_NOW | RTLD_LOCAL);
+    if (!lib) {
+        fprintf(stderr, "dlopen: %s\n", dlerror());
+        return 3;
+    }
+    CALL(Instantiate, fmi2Instantiate);
+    CALL(Setup, fmi2SetupExperiment);
+    CALL(Mode, fmi2EnterInitializationMode);
+    CALL(Mode, fmi2ExitInitializationMode);
+    CALL(SetReal, fmi2SetReal);
+    CALL(GetReal, fmi2GetReal);
+    CALL(DoStep, fmi2DoStep);
+    CALL(Mode, fmi2Terminate);
+    CALL(Free, fmi2FreeInstance);
+    unsigned vr_in[64], vr_out[64];
+    double u[64], y[64];
+    size_t n_in = 0, n_u = 0, n_out = 0;
+    int part = 0;
+    for (int i = 6; i < argc; i++) {
+        if (strcmp(argv[i], "--") == 0) part++;
+        else if (part == 0 && n_in < 64) vr_in[n_in++] = (unsigned)atoi(argv[i]);
+        else if (part == 1 && n_u < 64) u[n_u++] = atof(argv[i]);
+        else if (part == 2 && n_out < 64) vr_out[n_out++] = (unsigned)atoi(argv[i]);
+    }
+    Callbacks callbacks = {logger, calloc, free, NULL, NULL};
+    Component c = fmi2Instantiate("host", 1, argv[2], argv[3], &callbacks, 0, 0);
+    if (!c || n_u != n_in) return 4;
+    int status = fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0) | fmi2EnterInitializationMode(c) |
+                 fmi2ExitInitializationMode(c);
+    int steps = atoi(argv[4]);
+    double h = atof(argv[5]);
+    for (int k = 0; k < steps && status == 0; k++) {
+        status |= fmi2SetReal(c, vr_in, n_in, u);
+        status |= fmi2DoStep(c, k * h, h, 1);
+    }
+    status |= fmi2GetReal(c, vr_out, n_out, y);
+    for (size_t i = 0; i < n_out; i++) printf("%.17g\n", y[i]);
+    status |= fmi2Terminate(c);
+    fmi2FreeInstance(c);
+    fflush(stdout);
+    fflush(stderr);
+    _exit(status ? 5 : 0);
+}
