@@ -147,7 +147,7 @@ static const char *start_python(const char *binaries, char *message, size_t size
     int (*run)(const char *) = (int (*)(const char *))dlsym(py, "PyRun_SimpleString");
     void *(*release)(void) = (void *(*)(void))dlsym(py, "PyEval_SaveThread");
     if (!initialized || !initialize || !run || !release) {
-        snprintf(message, size, "%s lacks the Python C API", library);
+        snprintf(message, size, "%s lacks the Python C API", library[0] ? library : soname);
         return message;
     }
     if (!initialized()) {

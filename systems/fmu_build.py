@@ -48,12 +48,11 @@ def source_fingerprint(name: str) -> str:
 
 def python_environment() -> str:
     """What fmi2_guard.c starts Python from in a host without it: the path of this
-    interpreter's shared libpython, its soname (looked up on the library path where the
-    path does not exist), and the folders of this environment's packages as a list
-    literal (put first on sys.path). Empty lines where Python was built without a shared
-    library."""
-    shared = bool(sysconfig.get_config_var("Py_ENABLE_SHARED"))
-    soname = sysconfig.get_config_var("INSTSONAME") or "" if shared else ""
+    interpreter's shared libpython (empty where LIBDIR has none, e.g. a statically linked
+    interpreter whose distribution ships the library apart), its soname (looked up on the
+    library path), and the folders of this environment's packages as a list literal (put
+    first on sys.path)."""
+    soname = sysconfig.get_config_var("INSTSONAME") or ""
     library = Path(sysconfig.get_config_var("LIBDIR") or "") / soname if soname else None
     folders = [p for p in dict.fromkeys(site.getsitepackages() + [site.getusersitepackages()]) if Path(p).is_dir()]
     return f"{library if library and library.is_file() else ''}\n{soname}\n{json.dumps(folders)}\n"
