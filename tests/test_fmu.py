@@ -1,4 +1,4 @@
-"""The FMUs: validation, equality with the batch path, FMI robustness, the SSP diagram."""
+"""The FMUs: validation, equality with the batch path, FMI robustness, the SSP diagram, other importers."""
 import json
 import math
 import os
