@@ -61,11 +61,15 @@ def foreign_code(resources) -> str | None:
     if resources is None or loaded is None:
         return None
     source = Path(loaded.__file__).resolve().parent.parent
+    own = code_digest(resources)
     if source not in _loaded_digests:
-        if not (source / PROJECT_PACKAGES[0]).is_dir():
+        if source == Path(resources).resolve():
+            _loaded_digests[source] = own
+        elif (source / PROJECT_PACKAGES[0]).is_dir():
+            _loaded_digests[source] = code_digest(source)
+        else:
             return None  # gone before anything could compare with it
-        _loaded_digests[source] = code_digest(source)
-    if _loaded_digests[source] == code_digest(resources):
+    if _loaded_digests[source] == own:
         return None
     return (f"this FMU's code differs from the attitude-fmu code this process imported before it, from {source}; "
             "a process holds one copy of it: run FMUs of one build together, or each in a process of its own")

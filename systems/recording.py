@@ -119,9 +119,7 @@ def field_norm_note(rec: Recording) -> str | None:
     in any unit; only the hard-iron offset is then reported in the input's unit."""
     if rec.mag is None:
         return None
-    rows = rec.mag[np.isfinite(rec.mag).all(axis=1)]
-    if not len(rows):
-        return None
+    rows = rec.mag[np.isfinite(rec.mag).all(axis=1)]  # read_recording leaves no magnetometer without a sample
     norm = float(np.median(np.linalg.norm(rows, axis=1)))
     low, high = EARTH_FIELD_RANGE_UT
     if low / 2 <= norm <= 2 * high:
