@@ -17,6 +17,7 @@ from .heading import heading_step
 from .heading import initial_state as heading_initial_state
 from .heading import resolve as heading_resolve
 from .jit import kernel
+from .latency import carry_forward, check_latency
 from .methods import method as get_method, stepper
 from .quaternion import quat_euler_zyx
 from .sensor_frame import SensorFrameStepper, sensor_frame_step, start_gravity
@@ -44,9 +45,10 @@ def _finite_inputs(io):
 
 
 @kernel(inline=True)
-def _write_outputs(io, q, heading_state, heading_coef, heading):
+def _write_outputs(io, q, heading_state, heading_coef, heading, latency):
     """io[10:13] holds ĝ: normalise it; q, turned to the magnetometer's heading when asked
-    (io[16:19] not finite or all 0: no new field sample), and its Euler angles into io[6:10],
+    (io[16:19] not finite or all 0: no new field sample), both carried forward over latency
+    (s) with the gyro in io[0:3] (blocks.latency), and q's Euler angles into io[6:10],
     io[13:16]."""
     norm = math.sqrt(io[10] * io[10] + io[11] * io[11] + io[12] * io[12])
     for i in range(3):
@@ -54,12 +56,15 @@ def _write_outputs(io, q, heading_state, heading_coef, heading):
     out = (q[0], q[1], q[2], q[3])
     if heading:
         out, used = heading_step(heading_state, heading_coef, out, (io[16], io[17], io[18]))
+    if latency != 0.0:
+        out, up = carry_forward(out, (io[10], io[11], io[12]), (io[0], io[1], io[2]), latency)
+        io[10], io[11], io[12] = up
     io[6], io[7], io[8], io[9] = out
     io[13], io[14], io[15] = quat_euler_zyx(out)
 
 
 @kernel()
-def online_step(X, q, Xr, io, Ad, Bd, C, D, Ts, heading_state, heading_coef, heading):
+def online_step(X, q, Xr, io, Ad, Bd, C, D, Ts, heading_state, heading_coef, heading, latency):
     """One sample through sensor_frame_step with its inputs in io[0:6] (io[16:19] the
     field); writes io[6:16]. Returns False, touching nothing, when an input is not finite.
     (The sensor-frame methods' path: one compiled call per sample.)
@@ -68,14 +73,14 @@ def online_step(X, q, Xr, io, Ad, Bd, C, D, Ts, heading_state, heading_coef, hea
         return False
     rows = io[0:6].reshape((2, 3))
     sensor_frame_step(X, q, rows[0:1], rows[1:2], 0, Ad, Bd, C, D, Ts, Xr, io[10:13].reshape((1, 3)))
-    _write_outputs(io, q, heading_state, heading_coef, heading)
+    _write_outputs(io, q, heading_state, heading_coef, heading, latency)
     return True
 
 
 @kernel()
-def finish_outputs(io, q, heading_state, heading_coef, heading):
+def finish_outputs(io, q, heading_state, heading_coef, heading, latency):
     """The other methods' path: _write_outputs after their own step."""
-    _write_outputs(io, q, heading_state, heading_coef, heading)
+    _write_outputs(io, q, heading_state, heading_coef, heading, latency)
 
 
 class OnlineEstimator:
@@ -85,13 +90,14 @@ class OnlineEstimator:
     io[0:6] (and the magnetometer to io[16:19] with heading=True: blocks.heading, as the
     batch path's mag argument), outputs come from io[6:16] (see IO_*). gyro_offset=True:
     the gyro offset is estimated and removed first (blocks.gyro_offset, as the batch
-    path's gyro_offset argument). The filter starts at rest on the first accelerometer
-    sample with non-zero norm, as the batch path starts on its first sample; until then
-    `ready` is False.
+    path's gyro_offset argument). latency (s): the outputs are carried forward over the
+    IMU's delay (blocks.latency, as the batch path's latency argument). The filter starts
+    at rest on the first accelerometer sample with non-zero norm, as the batch path starts
+    on its first sample; until then `ready` is False.
     """
 
     def __init__(self, method: str = "wiener", params: Mapping[str, float] | None = None, heading: bool = False,
-                 gyro_offset: bool = False):
+                 gyro_offset: bool = False, latency: float = 0.0):
         params, offset_params, heading_params = split_params(method, params, gyro_offset, heading)
         m = get_method(method)
         m.runs_kernel(m.resolve(params))  # refuse bad parameters now
@@ -100,6 +106,7 @@ class OnlineEstimator:
         self._offset_params, self._heading_params = offset_resolve(offset_params), heading_resolve(heading_params)
         self.heading = heading
         self.gyro_offset = gyro_offset
+        self.latency = check_latency(latency)
         self.offset = np.zeros((2, 3))  # offset estimate (rad/s) and its variance ((rad/s)²)
         self.io = np.zeros(19)
         self._Ts = None
@@ -162,10 +169,11 @@ class OnlineEstimator:
         if self.sensor_frame:
             d = self._stepper.disc
             return online_step(*self._views, self.io, d.Ad, d.Bd, d.C, d.D, d.Ts,
-                               self._heading_state, self._heading_coef, self.heading)
+                               self._heading_state, self._heading_coef, self.heading, self.latency)
         if not np.isfinite(self.io[IO_INPUTS]).all():
             return False
         rows = self.io[0:6].reshape(2, 3)
         self._stepper.run(self.state, rows[0:1], rows[1:2], self.io[10:13].reshape(1, 3), self._quat)
-        finish_outputs(self.io, self._quat[0], self._heading_state, self._heading_coef, self.heading)
+        finish_outputs(self.io, self._quat[0], self._heading_state, self._heading_coef, self.heading,
+                       self.latency)
         return True

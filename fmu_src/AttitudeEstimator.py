@@ -56,6 +56,8 @@ class AttitudeEstimator(ProjectSlave):
         self.parameter("gyro_offset", "on", "on (default, as attitude estimate): estimate and remove the gyro offset "
                        "(at rest and while moving); off: for a gyro without offset")
         self.real("Ts", 0.01, "s", "sample time the estimator expects (other step sizes are re-discretised)", PAR)
+        self.real("latency", 0.0, "s", "the IMU's delay behind the motion (its filters' group delay, gyr taken as the "
+                  "mean rate over the step); q and g are carried forward over it with the gyro", PAR)
         for name, (unit, doc, start) in tuning_parameters().items():
             self.real(name, start, unit, doc, PAR)
         self.estimator = None
@@ -75,7 +77,7 @@ class AttitudeEstimator(ProjectSlave):
                   if getattr(self, name) != start}
         try:
             self.estimator = OnlineEstimator(self.method, params, heading=self.heading == "mag",
-                                             gyro_offset=self.gyro_offset == "on")
+                                             gyro_offset=self.gyro_offset == "on", latency=self.latency)
         except ValueError as exc:
             self.fail(f"invalid parameter: {exc}")
 

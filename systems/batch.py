@@ -11,6 +11,7 @@ from scipy.spatial.transform import Rotation
 
 from blocks.gyro_offset import correct as correct_gyro
 from blocks.heading import with_magnetometer
+from blocks.latency import carry_forward_rows, check_latency
 from blocks.stages import split_params
 from blocks.methods import METHODS, KernelStepper, method as get_method, stepper
 from blocks.sensor_frame import start_gravity, time_reversed
@@ -57,7 +58,7 @@ def check_imu(gyr, acc, fs: float) -> tuple[np.ndarray, np.ndarray]:
 
 def estimate(
     gyr, acc, fs: float, method: str = "wiener", params: Mapping[str, float] | None = None,
-    initial_gravity=None, offline: bool = False, gyro_offset: bool = False, mag=None,
+    initial_gravity=None, offline: bool = False, gyro_offset: bool = False, mag=None, latency: float = 0.0,
 ) -> AttitudeEstimate:
     """Estimate attitude over a recording: gyr N×3 rad/s, acc N×3 m/s², fs in Hz.
 
@@ -72,9 +73,11 @@ def estimate(
     offline from passes forward and backward in time; the estimate is returned as
     `offset`). mag (N×3, µT; rows with a NaN are missing samples): heading from the
     magnetometer with a guard against disturbances (blocks.heading); without it the
-    heading is the gyro's (6D).
+    heading is the gyro's (6D). latency (s): the IMU's delay behind the motion; the
+    estimate is carried forward over it with the (offset-free) gyro (blocks.latency).
     """
     gyr, acc = check_imu(gyr, acc, fs)
+    latency = check_latency(latency)
     params, offset_params, heading_params = split_params(method, params, gyro_offset, mag is not None)
     offset = None
     if gyro_offset:
@@ -85,7 +88,7 @@ def estimate(
     if not offline:
         forward = _run(step, gyr, acc, initial_gravity)
         forward.offset = offset
-        return _with_heading(forward, mag, fs, heading_params)
+        return _carried_forward(_with_heading(forward, mag, fs, heading_params), gyr, latency)
     if not get_method(method).is_sensor_frame:
         raise ValueError(f"offline smoothing needs an earth-frame filter method "
                          f"({', '.join(n for n, m in METHODS.items() if m.is_sensor_frame)}), not {method!r}")
@@ -101,7 +104,8 @@ def estimate(
         forward = _run(step, gyr, acc, initial_gravity)
         backward = _run(step, gyr_back, np.ascontiguousarray(forward.gravity[::-1]), forward.gravity[-1]).gravity
     gravity = backward[::-1].copy()
-    return _with_heading(AttitudeEstimate(gravity, level_onto(forward.quat, gravity), offset), mag, fs, heading_params)
+    est = AttitudeEstimate(gravity, level_onto(forward.quat, gravity), offset)
+    return _carried_forward(_with_heading(est, mag, fs, heading_params), gyr, latency)
 
 
 def _run_local(step, gyr, acc, initial_gravity, omega=None):
@@ -127,6 +131,12 @@ def _with_heading(est: AttitudeEstimate, mag, fs: float, params) -> AttitudeEsti
     if np.isnan(mag).any(axis=1).all():
         raise ValueError("mag has no sample without NaN: estimate without it (--heading gyro, or mag=None)")
     est.quat, est.mag_accepted, est.mag_offset = with_magnetometer(est.quat, mag, fs, params)
+    return est
+
+
+def _carried_forward(est: AttitudeEstimate, gyr, latency: float) -> AttitudeEstimate:
+    if latency:
+        carry_forward_rows(est.quat, est.gravity, gyr, latency)
     return est
 
 

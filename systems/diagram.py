@@ -8,6 +8,7 @@ import numpy as np
 from blocks import gyro_offset
 from blocks.heading import heading_system
 from blocks.heading import initial_state as heading_initial_state
+from blocks.latency import latency_system
 from blocks.methods import estimator_system, stepper
 from blocks.quaternion import quat_rotate
 from blocks.sensor_frame import GRAVITY_OUTPUTS, QUAT_NAMES
@@ -44,7 +45,7 @@ def magnetometer_system(fs: float, name: str = "magnetometer"):
 
 
 def closed_loop(motion: HumanMotion, imu: ImuModel, fs: float, method: str = "wiener",
-                params: dict | None = None, offset: bool = False, heading: bool = False):
+                params: dict | None = None, offset: bool = False, heading: bool = False, latency: float = 0.0):
     """The diagram and its initial state (estimator at rest on g·ẑ, motion level at rest).
     params: as blocks.stages.split_params, for the method and the stages below.
 
@@ -52,7 +53,9 @@ def closed_loop(motion: HumanMotion, imu: ImuModel, fs: float, method: str = "wi
     between sensor and estimator; heading: the heading stage (blocks.heading) on the
     estimator's orientation and the magnetometer. Inputs: NOISE_INPUTS (unit-normal
     samples); outputs: incl_err (rad), ghat_*, q_*, with offset the gyro offset estimate
-    offset_* (rad/s), with heading qh_* and the hard-iron estimate mag_offset_* (µT).
+    offset_* (rad/s), with heading qh_* and the hard-iron estimate mag_offset_* (µT);
+    latency (s, non-zero): the latency stage (blocks.latency) on the last orientation and
+    ghat_*, outputs ql_* and ghatl_*.
     """
     dt = 1.0 / fs
     params, offset_params, heading_params = split_params(method, params, offset, heading)
@@ -70,6 +73,9 @@ def closed_loop(motion: HumanMotion, imu: ImuModel, fs: float, method: str = "wi
         estimator += [magnetometer_system(fs), heading_system(dt, heading_params)]
         states.append(heading_initial_state())
         outputs += [f"qh_{c}" for c in "wxyz"] + [f"mag_offset_{a}" for a in AXES]
+    if latency:
+        estimator.append(latency_system(dt, latency, [f"q{'h' if heading else ''}_{c}" for c in "wxyz"]))
+        outputs += [f"ql_{c}" for c in "wxyz"] + [f"ghatl_{a}" for a in AXES]
     diagram = control.interconnect([motion.system(fs), sensor, *estimator, attitude_error_system(fs)],
                                    inplist=NOISE_INPUTS, outlist=outputs, outputs=outputs, name="closed_loop")
     return diagram, np.concatenate(states)
@@ -77,9 +83,9 @@ def closed_loop(motion: HumanMotion, imu: ImuModel, fs: float, method: str = "wi
 
 def simulate_closed_loop(motion: HumanMotion, imu: ImuModel, fs: float, duration: float,
                          method: str = "wiener", params: dict | None = None, seed: int = 0,
-                         offset: bool = False, heading: bool = False):
+                         offset: bool = False, heading: bool = False, latency: float = 0.0):
     """Short run of the diagram (see closed_loop) with fixed-seed noise: (noise N×12, response)."""
-    diagram, x0 = closed_loop(motion, imu, fs, method, params, offset, heading)
+    diagram, x0 = closed_loop(motion, imu, fs, method, params, offset, heading, latency)
     n = int(round(duration * fs))
     noise = np.random.default_rng(seed).standard_normal((n, len(NOISE_INPUTS)))
     t = np.arange(n) / fs

@@ -7,6 +7,10 @@ import math
 import sys
 
 import numpy as np
+from scipy.optimize import minimize_scalar
+from scipy.spatial.transform import Rotation
+
+from blocks.latency import carry_forward_rows, check_latency
 
 from .batch import estimate
 from .compare import peer_quaternions
@@ -14,6 +18,7 @@ from .errors import quaternion_errors
 from .recording import Recording, read_recording
 
 METRICS = ("total_rmse_deg", "heading_rmse_deg", "inclination_rmse_deg")
+LATENCY_SEARCH_S = 0.1  # imu_latency looks this far either way
 
 
 def errors_on_movement(quat, rec: Recording) -> dict:
@@ -25,39 +30,80 @@ def errors_on_movement(quat, rec: Recording) -> dict:
     return {name: math.degrees(float(np.sqrt(np.mean(e**2)))) for name, e in zip(METRICS, errors)}
 
 
+def imu_latency(rec: Recording) -> float | None:
+    """The IMU's latency behind its reference (s, in blocks.latency's convention): the
+    shift of the reference's mean rate over each sample time that best matches the gyro,
+    least squares over the movement phase within ±LATENCY_SEARCH_S. None where the
+    reference gives fewer than a second of rates or the best shift lies at the search's edge."""
+    ok = np.isfinite(rec.quat_ref).all(axis=1)
+    rot = Rotation.from_quat(np.where(ok[:, None], rec.quat_ref, [1.0, 0.0, 0.0, 0.0]), scalar_first=True)
+    rate = np.full(rec.gyr.shape, np.nan)  # rate[k]: the reference's mean rate over (t_k−1, t_k]
+    rate[1:] = (rot[:-1].inv() * rot[1:]).as_rotvec() * rec.fs
+    rate[~(ok & np.roll(ok, 1))] = np.nan
+    k = np.flatnonzero(np.isfinite(rate).all(axis=1) & (True if rec.movement is None else rec.movement))
+    if len(k) < rec.fs:
+        return None
+    gyr = rec.gyr[k]
+
+    def mismatch(lag):  # gyro sample k against the reference's rate at k − lag (samples)
+        shifted = np.column_stack([np.interp(k - lag, np.arange(len(rate)), rate[:, i]) for i in range(3)])
+        return float(np.nanmean(np.sum((gyr - shifted) ** 2, axis=1)))
+
+    reach = LATENCY_SEARCH_S * rec.fs
+    grid = np.linspace(-reach, reach, int(min(4 * reach, 400)) + 1)
+    best = int(np.argmin([mismatch(lag) for lag in grid]))
+    if best in (0, len(grid) - 1):
+        return None
+    step = grid[1] - grid[0]
+    return float(minimize_scalar(mismatch, bounds=(grid[best] - step, grid[best] + step), method="bounded",
+                                 options={"xatol": 1e-3}).x) / rec.fs
+
+
 def evaluate_recording(rec: Recording, method: str = "wiener", params=None, offline: bool = False,
-                       gyro_offset: bool = True, use_mag: bool = True) -> dict:
+                       gyro_offset: bool = True, use_mag: bool = True, latency: float = 0.0) -> dict:
     """{method label: {metric: value}} for one recording; with a magnetometer (and use_mag)
-    the method's heading comes from it, and vqf's 9D estimate is added as "vqf_9d"."""
+    the method's heading comes from it, and vqf's 9D estimate is added as "vqf_9d".
+    latency (s): every estimate, the peers' too, is carried forward over the IMU's delay
+    (blocks.latency; the peers' with the raw gyro)."""
     rec.evaluated()  # refuses a recording without a usable reference before any work
     import vqf as vqf_module  # peers: the test extra (or [peers])
 
     label = f"{method}_offline" if offline else method
     mag = rec.mag if use_mag else None
-    est = estimate(rec.gyr, rec.acc, rec.fs, method, params, offline=offline, gyro_offset=gyro_offset, mag=mag)
+    est = estimate(rec.gyr, rec.acc, rec.fs, method, params, offline=offline, gyro_offset=gyro_offset, mag=mag,
+                   latency=latency)
     gyr, acc = np.ascontiguousarray(rec.gyr), np.ascontiguousarray(rec.acc)
+
+    def peer(quat):
+        quat = np.array(quat, dtype=float)
+        if latency:
+            carry_forward_rows(quat, np.zeros_like(gyr), gyr, latency)
+        return errors_on_movement(quat, rec)
+
     table = {
         label: errors_on_movement(est.quat, rec),
-        "vqf": errors_on_movement(peer_quaternions("vqf", gyr, acc, rec.fs), rec),
-        "vqf_offline": errors_on_movement(vqf_module.offlineVQF(gyr, acc, None, 1.0 / rec.fs)["quat6D"], rec),
-        "madgwick": errors_on_movement(peer_quaternions("madgwick", gyr, acc, rec.fs), rec),
+        "vqf": peer(peer_quaternions("vqf", gyr, acc, rec.fs)),
+        "vqf_offline": peer(vqf_module.offlineVQF(gyr, acc, None, 1.0 / rec.fs)["quat6D"]),
+        "madgwick": peer(peer_quaternions("madgwick", gyr, acc, rec.fs)),
     }
     if mag is not None:  # vqf's "no sample" is a zero row, where ours is NaN
         mag = np.ascontiguousarray(np.where(np.isnan(mag).any(axis=1, keepdims=True), 0.0, mag))
-        nine_d = vqf_module.VQF(1.0 / rec.fs).updateBatch(gyr, acc, mag)["quat9D"]
-        table["vqf_9d"] = errors_on_movement(nine_d, rec)
+        table["vqf_9d"] = peer(vqf_module.VQF(1.0 / rec.fs).updateBatch(gyr, acc, mag)["quat9D"])
     return table
 
 
 def evaluate(paths, method: str = "wiener", params=None, offline: bool = False, gyro_offset: bool = True,
              use_mag: bool = True, progress: bool = True, start_in_movement: float | None = None,
-             read_options=None) -> dict:
-    """{"recordings": {name: {label: metrics}}, "mean": {label: metrics}} over the files;
+             read_options=None, latency: float = 0.0) -> dict:
+    """{"recordings": {name: {label: metrics}}, "mean": {label: metrics}, "imu_latency_s":
+    {name: seconds or None}} over the files (imu_latency: the IMU's delay behind the
+    reference, measured, whatever latency (s) the estimates were carried forward by);
     start_in_movement (s): cut each recording to begin that long into its movement phase;
     read_options: keyword arguments of read_recording (units, fs, max_gap). Every file is
     read and checked first. A recording's name is its file's stem, or its path where
     stems repeat. progress also prints how each file was read where it matters (time
     stamps, no movement flag)."""
+    check_latency(latency)
     read = []  # every file read and checked before any estimate: a bad last file costs nothing
     for path in paths:
         rec = read_recording(path, **(read_options or {}))
@@ -72,16 +118,22 @@ def evaluate(paths, method: str = "wiener", params=None, offline: bool = False, 
     names = [rec.name for _, rec in read]
     if len(set(names)) < len(names):  # files of one name from several folders: keyed by path
         names = [str(path) for path, _ in read]
-    recordings = {}
+    recordings, lags = {}, {}
     for i, (name, (path, rec)) in enumerate(zip(names, read)):
         if progress:
             done = int(20 * i / len(paths))
             print(f"\revaluate [{'#' * done}{'.' * (20 - done)}] {i + 1}/{len(paths)} {path}",
                   end="" if sys.stderr.isatty() else "\n", file=sys.stderr, flush=True)
-        recordings[name] = evaluate_recording(rec, method, params, offline, gyro_offset, use_mag)
+        recordings[name] = evaluate_recording(rec, method, params, offline, gyro_offset, use_mag, latency)
+        lags[name] = imu_latency(rec)
     if progress and sys.stderr.isatty():
         print(file=sys.stderr)
+    found = [lag for lag in lags.values() if lag is not None]
+    if progress and found:
+        print(f"attitude: note: the IMU lags the reference by {1e3 * min(found):.2f} to {1e3 * max(found):.2f} ms "
+              f"(gyro against the reference's rate); --latency S carries every estimate forward by S seconds "
+              f"(now {latency:g})", file=sys.stderr)
     labels = set.intersection(*(set(r) for r in recordings.values()))  # vqf_9d needs every file's mag
     mean = {label: {m: float(np.mean([r[label][m] for r in recordings.values()])) for m in METRICS}
             for label in next(iter(recordings.values())) if label in labels}
-    return {"recordings": recordings, "mean": mean}
+    return {"recordings": recordings, "mean": mean, "imu_latency_s": lags}

@@ -138,6 +138,7 @@ def _bad_inputs(tmp_path, gyr, acc):
     cases["unknown parameter 'mag_norm_tol'"] = (cols, ["--param", "mag_norm_tol=0.2"])  # no magnetometer
     cases["finite positive"] = (cols, ["--param", "delta_n=-1"])
     cases["disagrees"] = (cols, ["--fs", "50"])
+    cases["latency must be a finite number of seconds within ±0.5"] = (cols, ["--latency", "nan"])
     return cases
 
 

@@ -83,14 +83,15 @@ def test_every_fmu_validates(fmu_dir):
         assert validate_fmu(str(fmu_dir / f"{name}.fmu")) == [], name
 
 
+@pytest.mark.parametrize("latency", [0.0, 0.004])
 @pytest.mark.parametrize("method", sorted(METHODS))
-def test_estimator_fmu_equals_the_batch_path(fmu_dir, recording, method):
+def test_estimator_fmu_equals_the_batch_path(fmu_dir, recording, method, latency):
     gyr, acc = recording
     params = {"delta_n": 0.002} if any(p.name == "delta_n" for p in METHODS[method].params) else {}
-    runner = _estimator(fmu_dir, method=method, **params)
+    runner = _estimator(fmu_dir, method=method, latency=latency, **params)
     out, valid = runner.run(np.hstack([gyr, acc]), 1 / FS)
     runner.close()
-    ref = estimate(gyr, acc, FS, method, params)
+    ref = estimate(gyr, acc, FS, method, params, latency=latency)
     assert valid.all()
     assert np.abs(out[:, :4] - ref.quat).max() < 1e-9
     assert np.abs(out[:, 4:] - ref.up).max() < 1e-9
@@ -153,16 +154,18 @@ def test_estimator_fmu_with_gyro_offset_on_equals_the_batch_path(fmu_dir):
 
 def test_estimator_fmu_passes_gyro_offset_and_heading_parameters_on(fmu_dir):
     """The gyro-offset and heading estimators' parameters are FMU parameters too; delta_n
-    reaches the filter and the gyro-offset estimator alike, as in the batch path."""
+    reaches the filter and the gyro-offset estimator alike, as in the batch path; the
+    latency stage works on the offset-free gyro and the magnetometer's heading."""
     motion = profile("sine_rotation").motion({"inclination_deg": 20.0}).generate(20.0, FS)
     gyr, acc = ImuModel(delta_n=math.radians(0.05), gyr_offset=(0.0, 0.0, 0.01)).apply(motion, seed=3)
     params = {"delta_n": math.radians(0.3), "rest_time": 0.5, "tau_heading": 2.0, "mag_cal_time": 0.0}
-    runner = FmuRunner(fmu_dir / "AttitudeEstimator.fmu", {"gyro_offset": "on", **params},
+    runner = FmuRunner(fmu_dir / "AttitudeEstimator.fmu", {"gyro_offset": "on", "latency": 0.005, **params},
                        INPUTS + ["mag_x", "mag_y", "mag_z"], OUTPUTS + ["gyr_offset_x", "gyr_offset_y", "gyr_offset_z"])
     out, _ = runner.run(np.hstack([gyr, acc, motion.mag]), 1 / FS)
     runner.close()
-    ref = estimate(gyr, acc, FS, params=params, gyro_offset=True, mag=motion.mag)
+    ref = estimate(gyr, acc, FS, params=params, gyro_offset=True, mag=motion.mag, latency=0.005)
     assert np.abs(out[:, :4] - ref.quat).max() < 1e-9 and np.abs(out[:, 7:10] - ref.offset).max() < 1e-12
+    assert np.abs(out[:, 4:7] - ref.up).max() < 1e-9
     assert np.abs(out[:, :4] - estimate(gyr, acc, FS, gyro_offset=True, mag=motion.mag).quat).max() > 1e-4
 
 
@@ -254,6 +257,7 @@ def test_estimator_fmu_takes_a_zero_where_zero_is_a_setting(fmu_dir, recording, 
     ({"method": "wiener", "omega_f": 0.1}, "unknown parameter 'omega_f'"),
     ({"heading": "compass"}, "heading must be 'mag' or 'gyro'"),
     ({"gyro_offset": "yes"}, "gyro_offset must be 'on' or 'off'"),
+    ({"latency": 1.0}, "latency must be a finite number of seconds within"),
 ])
 def test_invalid_parameter_ends_initialisation_in_fmi2_error(fmu_dir, parameters, message, capsys):
     """The model logs the error (a Python exception would end in fmi2Fatal and corrupt the

@@ -7,6 +7,7 @@ from scipy.spatial.transform import Rotation
 
 from blocks import gyro_offset
 from blocks.heading import with_magnetometer
+from blocks.latency import carry_forward_rows
 from systems.batch import estimate
 from systems.diagram import simulate_closed_loop
 from systems.errors import inclination_error
@@ -87,16 +88,18 @@ def test_closed_loop_diagram_equals_the_batch_pipeline(method):
     assert np.abs(resp.outputs[0] - inclination_error(est.gravity, up)).max() <= 1e-12
 
 
-@pytest.mark.parametrize("params", [{}, {"delta_n": math.radians(0.3), "rest_time": 1.0, "tau_heading": 2.0}])
-def test_closed_loop_diagram_with_offset_and_heading_blocks_equals_the_batch_kernels(params):
+@pytest.mark.parametrize("params, latency", [({}, 0.0), ({"delta_n": math.radians(0.3), "rest_time": 1.0,
+                                                            "tau_heading": 2.0}, 0.004)])
+def test_closed_loop_diagram_with_offset_and_heading_blocks_equals_the_batch_kernels(params, latency):
     """motion → sensor → gyro-offset estimator → wiener → heading stage (fed by an ideal
-    magnetometer) as python-control blocks: the same numbers as the batch path's kernels
-    run over the sensor's samples (the offset estimator's low-passes at rest on g·ẑ, as
-    the diagram starts it), with the defaults and with parameters of every stage."""
+    magnetometer) → latency stage as python-control blocks: the same numbers as the batch
+    path's kernels run over the sensor's samples (the offset estimator's low-passes at rest
+    on g·ẑ, as the diagram starts it), with the defaults and with parameters of every stage."""
     motion = HumanMotion()
     imu = ImuModel(delta_n=math.radians(0.1), gyr_offset=(0.01, 0.0, -0.01), acc_noise=0.01)
     fs = 100.0
-    noise, resp = simulate_closed_loop(motion, imu, fs, duration=5.0, params=params, seed=3, offset=True, heading=True)
+    noise, resp = simulate_closed_loop(motion, imu, fs, duration=5.0, params=params, seed=3, offset=True, heading=True,
+                                       latency=latency)
     noise_density = {k: v for k, v in params.items() if k == "delta_n"}  # the filter's and the offset estimator's
     offset_params = {**noise_density, **{k: v for k, v in params.items() if k == "rest_time"}}
     heading_params = {k: v for k, v in params.items() if k == "tau_heading"}
@@ -116,3 +119,10 @@ def test_closed_loop_diagram_with_offset_and_heading_blocks_equals_the_batch_ker
     assert np.abs(np.column_stack([out[f"qh_{c}"] for c in "wxyz"]) - quat).max() <= 1e-12
     assert np.abs(np.column_stack([out[f"mag_offset_{c}"] for c in "xyz"]) - mag_offset).max() == 0.0
     assert np.abs(quat - est.quat).max() > 1e-3  # the heading stage turned the estimate
+    if latency:
+        gravity = est.gravity.copy()
+        carry_forward_rows(quat, gravity, gyr - offset, latency)
+        assert np.abs(np.column_stack([out[f"ql_{c}"] for c in "wxyz"]) - quat).max() <= 1e-12
+        assert np.abs(np.column_stack([out[f"ghatl_{c}"] for c in "xyz"]) - gravity).max() <= 1e-12
+    else:
+        assert "ql_w" not in out

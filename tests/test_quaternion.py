@@ -3,6 +3,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from blocks.latency import carry_forward_rows
 from blocks.quaternion import level_quat, quat_multiply, quat_normalized, quat_rotate, rotvec_quat
 
 RNG = np.random.default_rng(7)
@@ -37,3 +38,16 @@ def test_level_quat_is_the_smallest_rotation_onto_up(u):
     # smallest: the rotation angle equals the angle between u and up, about a horizontal axis
     assert np.isclose(rot.magnitude(), np.arccos(np.clip(u[2] / norm, -1, 1)), atol=1e-7)
     assert abs(rot.as_rotvec()[2]) < 1e-12
+
+
+def test_carry_forward_matches_scipy():
+    """blocks.latency: q ⊗ exp(ω·L) and the up-vector in the sensor frame L later."""
+    rot = Rotation.random(40, random_state=3)
+    gyr, gravity, latency = RNG.normal(scale=3.0, size=(40, 3)), RNG.normal(scale=9.81, size=(40, 3)), 0.004
+    quat, up = rot.as_quat(scalar_first=True), gravity.copy()
+    carry_forward_rows(quat, up, gyr, latency)
+    turn = Rotation.from_rotvec(gyr * latency)
+    assert np.abs(quat - (rot * turn).as_quat(scalar_first=True)).max() < 1e-15
+    assert np.abs(up - turn.inv().apply(gravity)).max() < 1e-13
+    # the up-vector and the orientation stay consistent: both give the same earth vector
+    assert np.abs(Rotation.from_quat(quat, scalar_first=True).apply(up) - rot.apply(gravity)).max() < 1e-12

@@ -1,0 +1,65 @@
+"""Latency compensation: an IMU's samples lag the motion (the group delay of its digital
+filters, a few milliseconds), so an estimate made from them shows the orientation of that
+long ago. This stage carries the estimate forward over the latency with the gyro:
+q ← q ⊗ exp(ω·L), and the up-vector into the sensor frame of that moment.
+
+The latency L (s) is counted in the project's sample convention: gyro sample k is the
+mean rate over the sample time before t_k (as a closed-form motion's `at`, and the
+FMU's `gyr` input). A sensor whose rate is a point sample taken d seconds late has
+L = d − Ts/2. `attitude evaluate` measures L against an optical reference
+(systems.evaluate.imu_latency). One kernel serves the batch path, the online step (FMU)
+and the python-control block.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .jit import kernel
+from .quaternion import quat_multiply, quat_rotate, rotvec_quat
+from .stepper_system import sample_system
+
+MAX_LATENCY_S = 0.5  # the gyro's last rate is no guide to the orientation further ahead
+
+
+def check_latency(latency: float) -> float:
+    """latency (s) as a float, refused unless finite and within ±MAX_LATENCY_S."""
+    latency = float(latency)
+    if not (math.isfinite(latency) and abs(latency) <= MAX_LATENCY_S):
+        raise ValueError(f"latency must be a finite number of seconds within ±{MAX_LATENCY_S:g}, got {latency!r}")
+    return latency
+
+
+@kernel(inline=True)
+def carry_forward(q, up, gyr, latency):
+    """(q ⊗ exp(gyr·latency), up in the sensor frame latency seconds later): q sensor →
+    earth (4-tuple), up (3-tuple, any length), gyr (rad/s, 3-tuple), latency (s)."""
+    dq = rotvec_quat(gyr[0] * latency, gyr[1] * latency, gyr[2] * latency)
+    return quat_multiply(q, dq), quat_rotate((dq[0], -dq[1], -dq[2], -dq[3]), up)
+
+
+@kernel()
+def carry_forward_rows(quat, gravity, gyr, latency):
+    """carry_forward on every row of quat (N×4) and gravity (N×3), in place; gyr N×3 (rad/s)."""
+    for k in range(quat.shape[0]):
+        q, up = carry_forward((quat[k, 0], quat[k, 1], quat[k, 2], quat[k, 3]),
+                              (gravity[k, 0], gravity[k, 1], gravity[k, 2]),
+                              (gyr[k, 0], gyr[k, 1], gyr[k, 2]), latency)
+        quat[k, 0], quat[k, 1], quat[k, 2], quat[k, 3] = q
+        gravity[k, 0], gravity[k, 1], gravity[k, 2] = up
+
+
+def latency_system(dt: float, latency: float, quat_inputs=("q_w", "q_x", "q_y", "q_z"), name: str = "latency"):
+    """Static python-control block: inputs gyr_x..z (rad/s), the orientation (quat_inputs)
+    and ghat_x..z (m/s²); outputs ql_w..z and ghatl_x..z, both carried forward over
+    latency (s)."""
+    latency = check_latency(latency)
+
+    def advance(state, u):
+        quat, gravity = u[3:7].reshape(1, 4).copy(), u[7:10].reshape(1, 3).copy()
+        carry_forward_rows(quat, gravity, u[0:3].reshape(1, 3).copy(), latency)
+        return state, np.concatenate([quat[0], gravity[0]])
+
+    return sample_system(advance, [f"gyr_{a}" for a in "xyz"] + list(quat_inputs) + [f"ghat_{a}" for a in "xyz"],
+                         [f"ql_{c}" for c in "wxyz"] + [f"ghatl_{a}" for a in "xyz"], [], dt, name)
