@@ -50,8 +50,8 @@ def plot_recording(path, out, method: str = "wiener", params=None, offline: bool
     top.set_xlabel("time, s")
     top.set_ylabel("inclination error, °")
     rmse = {"inclination_rmse_deg": math.sqrt(float(np.nanmean(inclination**2)))}
-    label = f"{method}{' --offline' if offline else ''}"
-    top.set_title(f"{rec.name}: {label}, RMSE {rmse['inclination_rmse_deg']:.2f}° over the movement phase")
+    label = f"{method}{' --offline' if offline else ''}{f' --latency {latency:g}' if latency else ''}"
+    top.set_title(f"{rec.name}: {label}\nRMSE {rmse['inclination_rmse_deg']:.2f}° over the movement phase")
     if mag is not None:
         rmse["heading_rmse_deg"] = math.sqrt(float(np.nanmean(heading_error**2)))
         _heading_panel(axes[1], t, heading_error, est, rmse["heading_rmse_deg"])
