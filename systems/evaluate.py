@@ -19,6 +19,7 @@ from .recording import Recording, read_recording
 
 METRICS = ("total_rmse_deg", "heading_rmse_deg", "inclination_rmse_deg")
 LATENCY_SEARCH_S = 0.1  # imu_latency looks this far either way
+LATENCY_SAMPLES = 200_000  # at most this many gyro samples, evenly spread, enter imu_latency's fit
 
 
 def errors_on_movement(quat, rec: Recording) -> dict:
@@ -33,8 +34,10 @@ def errors_on_movement(quat, rec: Recording) -> dict:
 def imu_latency(rec: Recording) -> float | None:
     """The IMU's latency behind its reference (s, in blocks.latency's convention): the
     shift of the reference's mean rate over each sample time that best matches the gyro,
-    least squares over the movement phase within ±LATENCY_SEARCH_S. None where the
-    reference gives fewer than a second of rates or the best shift lies at the search's edge."""
+    least squares over the movement phase (at most LATENCY_SAMPLES of it) within
+    ±LATENCY_SEARCH_S: a grid of at most 201 shifts, then a bounded search around the best.
+    None where the reference gives fewer than a second of rates or the best shift lies at
+    the search's edge."""
     ok = np.isfinite(rec.quat_ref).all(axis=1)
     rot = Rotation.from_quat(np.where(ok[:, None], rec.quat_ref, [1.0, 0.0, 0.0, 0.0]), scalar_first=True)
     rate = np.full(rec.gyr.shape, np.nan)  # rate[k]: the reference's mean rate over (t_k−1, t_k]
@@ -43,6 +46,7 @@ def imu_latency(rec: Recording) -> float | None:
     k = np.flatnonzero(np.isfinite(rate).all(axis=1) & (True if rec.movement is None else rec.movement))
     if len(k) < rec.fs:
         return None
+    k = k[::-(-len(k) // LATENCY_SAMPLES)]
     gyr = rec.gyr[k]
 
     def mismatch(lag):  # gyro sample k against the reference's rate at k − lag (samples)
@@ -50,7 +54,7 @@ def imu_latency(rec: Recording) -> float | None:
         return float(np.nanmean(np.sum((gyr - shifted) ** 2, axis=1)))
 
     reach = LATENCY_SEARCH_S * rec.fs
-    grid = np.linspace(-reach, reach, int(min(4 * reach, 400)) + 1)
+    grid = np.linspace(-reach, reach, 2 * int(min(reach, 100)) + 1)  # steps of a sample or more
     best = int(np.argmin([mismatch(lag) for lag in grid]))
     if best in (0, len(grid) - 1):
         return None
