@@ -1,7 +1,9 @@
 """ImuSensor.fmu: ideal motion signals in, measured IMU signals out (systems.sensor_model.ImuModel).
 
 Noise is drawn per step from numpy's generator seeded with `seed`, in the order the
-batch path draws it, so a run equals ImuModel.apply on the same samples.
+batch path draws it, so a run equals ImuModel.apply on the same samples. With a
+`latency`, the measured signals are those of the motion that long ago (ImuModel's delay
+line; before the first step, the motion of the first step), which needs a fixed step.
 """
 from __future__ import annotations
 
@@ -10,9 +12,9 @@ import math
 import numpy as np
 from fmu_support import IN, OUT, PAR, Integer, ProjectSlave
 
+from blocks.online import same_step
 from systems.motion import EARTH_FIELD_UT
 from systems.sensor_model import ImuModel
-
 
 
 class ImuSensor(ProjectSlave):
@@ -34,6 +36,7 @@ class ImuSensor(ProjectSlave):
                         f"gyro scale and misalignment error: share of the true rate's {{c}} in gyr_{row}", PAR)
         self.real("acc_noise", 0.0, "m/s2/sqrt(Hz)", "accelerometer white-noise density, one-sided", PAR)
         self.vector("acc_offset", (0.0, 0.0, 0.0), "m/s2", "constant accelerometer offset {c}", PAR)
+        self.real("latency", 0.0, "s", "how long gyr and acc lag the motion (a fixed step needed)", PAR)
         self.parameter("seed", 1, "seed of the noise generator", Integer)
         self.model = None
 
@@ -44,8 +47,10 @@ class ImuSensor(ProjectSlave):
                 gyr_offset=(self.gyr_offset_x, self.gyr_offset_y, self.gyr_offset_z),
                 gyr_scale=tuple(tuple(getattr(self, f"gyr_scale_{row}_{c}") for c in "xyz") for row in "xyz"),
                 acc_offset=(self.acc_offset_x, self.acc_offset_y, self.acc_offset_z),
+                latency=self.latency,
             )
             self.rng = np.random.default_rng(self.seed)
+            self.delay, self.step_size = None, None
         except ValueError as exc:
             self.fail(f"invalid parameter: {exc}")
 
@@ -54,10 +59,14 @@ class ImuSensor(ProjectSlave):
             return self.refuse_step()
         if not (math.isfinite(step_size) and step_size > 0):
             return self.fail(f"step size must be positive, got {step_size!r}")
-        gyr, acc = self.model.measure(
-            (self.omega_x, self.omega_y, self.omega_z), (self.f_x, self.f_y, self.f_z),
-            self.rng.standard_normal(6), 1.0 / step_size,
-        )
+        signals = np.array([self.omega_x, self.omega_y, self.omega_z, self.f_x, self.f_y, self.f_z])
+        if self.model.latency:
+            if self.delay is None:
+                self.delay, self.step_size = self.model.delay_state(1.0 / step_size, signals), step_size
+            elif not same_step(step_size, self.step_size):
+                return self.fail(f"latency needs a fixed step: got {step_size!r} s after {self.step_size!r} s")
+            self.delay, signals = self.model.delay_step(self.delay, signals, 1.0 / self.step_size)
+        gyr, acc = self.model.measure(signals[0:3], signals[3:6], self.rng.standard_normal(6), 1.0 / step_size)
         self.gyr_x, self.gyr_y, self.gyr_z = (float(v) for v in gyr)
         self.acc_x, self.acc_y, self.acc_z = (float(v) for v in acc)
         self.mag_x, self.mag_y, self.mag_z = self.m_x, self.m_y, self.m_z

@@ -62,6 +62,8 @@ def closed_loop(motion: HumanMotion, imu: ImuModel, fs: float, method: str = "wi
     sensor = imu.system(fs)
     estimator = [estimator_system(method, params, dt)]
     states = [motion.initial_state()]
+    if imu.latency:  # the sensor's delay line, on a motion at rest, level, before the start
+        states.append(imu.delay_state(fs, [0.0, 0.0, 0.0, 0.0, 0.0, motion.g]))
     if offset:
         sensor.update_names(outputs=[f"{s}_{a}" for s in ("gyr_raw", "acc") for a in AXES])
         estimator.insert(0, gyro_offset.offset_system(dt, offset_params))

@@ -19,7 +19,9 @@ class ImuModel:
     scale-factor and misalignment error S (3×3, row i: what axis i adds of each true
     rate component; 1 = 100 %); acc_noise:
     accelerometer white-noise density, m/s²/√Hz; acc_offset: constant accelerometer
-    offset, m/s² (3). Noise enters as unit-normal samples, 6 per sample (gyro, acc).
+    offset, m/s² (3); latency: how long the measured gyro and accelerometer lag the motion,
+    s (see delay_step; blocks.latency compensates it). Noise enters as unit-normal
+    samples, 6 per sample (gyro, acc).
     """
 
     delta_n: float = 0.0
@@ -27,9 +29,10 @@ class ImuModel:
     gyr_scale: tuple = ((0.0, 0.0, 0.0),) * 3
     acc_noise: float = 0.0
     acc_offset: tuple = (0.0, 0.0, 0.0)
+    latency: float = 0.0
 
     def __post_init__(self):
-        for name in ("delta_n", "acc_noise"):
+        for name in ("delta_n", "acc_noise", "latency"):
             value = getattr(self, name)
             if not (math.isfinite(value) and value >= 0):
                 raise ValueError(f"{name} must be finite and non-negative, got {value!r}")
@@ -52,20 +55,48 @@ class ImuModel:
         acc = np.asarray(f) + self.acc_noise * scale * noise[..., 3:6] + np.asarray(self.acc_offset)
         return gyr, acc
 
+    def delay_state(self, fs: float, first) -> np.ndarray:
+        """The delay line's state at sample rate fs (Hz) before the first sample: the past
+        (ω, f) rows (6 each, flat), all equal to first (the motion before it began)."""
+        return np.tile(np.asarray(first, dtype=float), int(math.floor(self.latency * fs)) + 1)
+
+    def delay_step(self, state, signals, fs: float) -> tuple[np.ndarray, np.ndarray]:
+        """(next state, signals latency seconds ago) for this sample's true (ω, f) (6).
+        Both are means over the sample time (systems.motion), constant within each: the
+        mean over an interval latency = (m + φ)/fs earlier is (1 − φ)·x[k − m] + φ·x[k − m − 1]."""
+        m, phase = divmod(self.latency * fs, 1.0)
+        rows = np.concatenate([np.asarray(signals, dtype=float), state]).reshape(-1, 6)  # x[k], x[k−1], …
+        return rows[:-1].ravel(), (1.0 - phase) * rows[int(m)] + phase * rows[int(m) + 1]
+
+    def delayed(self, omega, f, fs: float, before=None) -> tuple[np.ndarray, np.ndarray]:
+        """The true rate and specific force (N×3 each) latency seconds ago, through the
+        delay line at fs (Hz); before (ω, f; 6): the motion before the first sample (default
+        that sample)."""
+        signals = np.hstack([omega, f])
+        if self.latency:
+            state = self.delay_state(fs, signals[0] if before is None else before)
+            for k, row in enumerate(signals):
+                state, signals[k] = self.delay_step(state, row, fs)
+        return signals[:, 0:3], signals[:, 3:6]
+
     def apply(self, motion: Motion, seed: int = 1) -> tuple[np.ndarray, np.ndarray]:
-        """Measured (gyr, acc) of a motion, with noise drawn from a fixed seed."""
+        """Measured (gyr, acc) of a motion, with noise drawn from a fixed seed (with a
+        latency, of the motion that long ago: delayed)."""
         noise = np.random.default_rng(seed).standard_normal((len(motion.gyr), 6))
-        return self.measure(motion.gyr, motion.acc, noise, motion.fs)
+        return self.measure(*self.delayed(motion.gyr, motion.acc, motion.fs), noise, motion.fs)
 
     def system(self, fs: float, name: str = "imu"):
         """Discrete python-control system: inputs omega_*, f_*, n_*, na_* (unit normal);
-        outputs gyr_*, acc_*."""
+        outputs gyr_*, acc_*; with a latency, states the delay line's (x0: delay_state)."""
         def output(t, x, u, params):
-            gyr, acc = self.measure(u[0:3], u[3:6], u[6:12], fs)
+            signals = self.delay_step(x, u[0:6], fs)[1] if self.latency else u[0:6]
+            gyr, acc = self.measure(signals[0:3], signals[3:6], u[6:12], fs)
             return np.concatenate([gyr, acc])
 
+        update = (lambda t, x, u, params: self.delay_step(x, u[0:6], fs)[0]) if self.latency else None
+        states = len(self.delay_state(fs, np.zeros(6))) if self.latency else None
         return control.nlsys(
-            None, output, name=name, dt=1.0 / fs,
+            update, output, name=name, dt=1.0 / fs, states=states,
             inputs=[f"{s}_{a}" for s in ("omega", "f", "n", "na") for a in AXES],
             outputs=[f"gyr_{a}" for a in AXES] + [f"acc_{a}" for a in AXES],
         )

@@ -20,7 +20,7 @@ from blocks.methods import METHODS
 from blocks.online import STEP_TOLERANCE, OnlineEstimator
 from systems.batch import estimate
 from systems.cosim import FmuRunner, cosimulate, cosimulate_libcosim
-from systems.errors import inclination_error
+from systems.errors import inclination_error, rms
 from systems.fmu_build import (FINGERPRINT, FMU_NAMES, build, built_from, ensure_built, python_environment,
                                source_fingerprint)
 from systems.motion import HumanMotion, profile
@@ -290,6 +290,7 @@ def test_an_fmu_of_other_code_than_the_process_has_loaded_ends_initialisation_in
 @pytest.mark.parametrize("name, parameters, message", [
     ("ImuSensor", {"delta_n": -1.0}, "delta_n"),
     ("ImuSensor", {"seed": -3}, "negative"),
+    ("ImuSensor", {"latency": -0.01}, "latency must be finite and non-negative"),
     ("MotionProfile", {"profile": "jogging"}, "jogging"),
     ("MotionProfile", {"seed": -3}, "negative"),
 ])
@@ -299,6 +300,17 @@ def test_invalid_parameters_of_the_other_fmus_end_in_fmi2_error(fmu_dir, name, p
     assert info.value.status == 3
     log = capsys.readouterr().out
     assert "[ERROR] invalid parameter" in log and message in log, log
+
+
+def test_a_late_sensor_fmu_refuses_a_changed_step(fmu_dir, capsys):
+    """The delay line holds samples of one step size: another step ends in fmi2Error saying why."""
+    runner = FmuRunner(fmu_dir / "ImuSensor.fmu", {"latency": 0.015}, [f"f_{c}" for c in "xyz"], ["acc_z"])
+    assert runner.step([0.0, 0.0, 9.81], 0.01)[0][0] == 9.81
+    with pytest.raises(FMICallException) as info:
+        runner.step([0.0, 0.0, 9.81], 0.02)
+    assert info.value.status == 3
+    runner.close()
+    assert "latency needs a fixed step: got 0.02 s after 0.01 s" in capsys.readouterr().out
 
 
 def test_fmi_status_follows_the_log_and_reset_clears_an_error(fmu_dir, recording, capsys):
@@ -343,11 +355,11 @@ def test_non_finite_inputs_hold_the_estimate_and_clear_valid(fmu_dir, recording,
 GYR_SCALE = ((0.002, 0.01, 0.0), (0.0, -0.003, 0.0), (-0.005, 0.0, 0.004))  # scale and misalignment
 
 
-def _batch_pipeline(duration, seed_motion, seed_imu, delta_n, method="wiener"):
+def _batch_pipeline(duration, seed_motion, seed_imu, delta_n, method="wiener", latency=0.0, compensated=0.0):
     motion = profile("human").motion().generate(duration, FS, seed_motion)
-    gyr, acc = ImuModel(delta_n=delta_n, gyr_scale=GYR_SCALE).apply(motion, seed_imu)
+    gyr, acc = ImuModel(delta_n=delta_n, gyr_scale=GYR_SCALE, latency=latency).apply(motion, seed_imu)
     # the sensor passes the field on; the estimator FMU's default estimates the gyro offset
-    return motion, estimate(gyr, acc, FS, method, mag=motion.mag, gyro_offset=True)
+    return motion, estimate(gyr, acc, FS, method, mag=motion.mag, gyro_offset=True, latency=compensated)
 
 
 @pytest.mark.parametrize("method", sorted(METHODS))
@@ -363,6 +375,31 @@ def test_ssp_diagram_under_the_master_equals_the_batch_pipeline(fmu_dir, tmp_pat
     assert np.abs(np.column_stack([out[f"motion.qt_{c}"] for c in "wxyz"]) - motion.quat).max() < 1e-12
     assert np.abs(np.column_stack([out[f"estimator.q_{c}"] for c in "wxyz"]) - ref.quat).max() < 1e-9
     assert out["estimator.valid"].all()
+
+
+def test_a_late_sensor_fmu_and_the_estimator_fmus_latency_under_the_master_equal_the_batch_pipeline(fmu_dir, tmp_path):
+    """ImuSensor.fmu with a latency of 1.5 steps (its delay line, ImuModel's) and the
+    estimator FMU carrying its estimate forward over it: the batch pipeline's numbers, and
+    against the truth the tilt error of a sensor without delay (within 5 %), where
+    uncompensated the delay adds half of it again."""
+    dn, latency = math.radians(0.1), 1.5 / FS
+    errors = {}
+    for compensated in (0.0, latency):
+        ssp = write_ssp(tmp_path / "late.ssp", fmu_dir, {
+            "motion": {"profile": "human", "seed": 3},
+            "imu": {"delta_n": dn, "seed": 4, "latency": latency,
+                    **{f"gyr_scale_{r}_{c}": GYR_SCALE[i][j] for i, r in enumerate("xyz") for j, c in enumerate("xyz")}},
+            "estimator": {"latency": compensated}}, 60.0, 1 / FS)
+        out = cosimulate(ssp, 60.0, 1 / FS)
+        motion, ref = _batch_pipeline(60.0, 3, 4, dn, latency=latency, compensated=compensated)
+        up = np.column_stack([out[f"estimator.g_{c}"] for c in "xyz"])
+        assert np.abs(np.column_stack([out[f"estimator.q_{c}"] for c in "wxyz"]) - ref.quat).max() < 1e-9
+        assert np.abs(up - ref.up).max() < 1e-9
+        errors[compensated] = rms(inclination_error(up[int(20 * FS):], motion.up[int(20 * FS):]))
+    prompt = rms(inclination_error(_batch_pipeline(60.0, 3, 4, dn)[1].up[int(20 * FS):], motion.up[int(20 * FS):]))
+    print(f"tilt RMS: sensor 15 ms late {math.degrees(errors[0.0]):.3f}°, carried forward "
+          f"{math.degrees(errors[latency]):.3f}°, sensor without delay {math.degrees(prompt):.3f}°")
+    assert errors[latency] == pytest.approx(prompt, rel=0.05) and errors[0.0] > 1.5 * prompt
 
 
 def test_fmpy_simulate_ssp_runs_the_same_diagram_one_step_per_connection_later(fmu_dir, tmp_path):

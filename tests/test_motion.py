@@ -11,7 +11,7 @@ from blocks.latency import carry_forward_rows
 from systems.batch import estimate
 from systems.diagram import simulate_closed_loop
 from systems.errors import inclination_error
-from systems.motion import EARTH_FIELD_UT, HumanMotion, _human_run, incline_oscillation, steady_lever_arm
+from systems.motion import EARTH_FIELD_UT, PROFILES, HumanMotion, _human_run, incline_oscillation, steady_lever_arm
 from systems.sensor_model import ImuModel
 
 
@@ -89,14 +89,15 @@ def test_closed_loop_diagram_equals_the_batch_pipeline(method):
 
 
 @pytest.mark.parametrize("params, latency", [({}, 0.0), ({"delta_n": math.radians(0.3), "rest_time": 1.0,
-                                                            "tau_heading": 2.0}, 0.004)])
+                                                            "tau_heading": 2.0}, 0.015)])
 def test_closed_loop_diagram_with_offset_and_heading_blocks_equals_the_batch_kernels(params, latency):
     """motion → sensor → gyro-offset estimator → wiener → heading stage (fed by an ideal
     magnetometer) → latency stage as python-control blocks: the same numbers as the batch
     path's kernels run over the sensor's samples (the offset estimator's low-passes at rest
-    on g·ẑ, as the diagram starts it), with the defaults and with parameters of every stage."""
+    on g·ẑ, as the diagram starts it), with the defaults and with parameters of every
+    stage; with a latency, the sensor's delay line (at rest, level before the start) as well."""
     motion = HumanMotion()
-    imu = ImuModel(delta_n=math.radians(0.1), gyr_offset=(0.01, 0.0, -0.01), acc_noise=0.01)
+    imu = ImuModel(delta_n=math.radians(0.1), gyr_offset=(0.01, 0.0, -0.01), acc_noise=0.01, latency=latency)
     fs = 100.0
     noise, resp = simulate_closed_loop(motion, imu, fs, duration=5.0, params=params, seed=3, offset=True, heading=True,
                                        latency=latency)
@@ -106,7 +107,8 @@ def test_closed_loop_diagram_with_offset_and_heading_blocks_equals_the_batch_ker
     state = motion.initial_state()
     truth = np.empty((len(noise), 10))
     _human_run(state, np.ascontiguousarray(noise[:, :6]), motion.coefficients(fs), truth)
-    gyr, acc = imu.measure(truth[:, 0:3], truth[:, 3:6], noise[:, 6:12], fs)
+    signals = imu.delayed(truth[:, 0:3], truth[:, 3:6], fs, before=[0.0, 0.0, 0.0, 0.0, 0.0, motion.g])
+    gyr, acc = imu.measure(*signals, noise[:, 6:12], fs)
     coef = gyro_offset.coefficients(gyro_offset.resolve(offset_params), 1.0 / fs)
     offset, variance = np.empty_like(gyr), np.empty_like(gyr)
     gyro_offset.run(gyro_offset.initial_state(coef, np.zeros(3), np.array([0.0, 0.0, motion.g])), coef,
@@ -126,3 +128,25 @@ def test_closed_loop_diagram_with_offset_and_heading_blocks_equals_the_batch_ker
         assert np.abs(np.column_stack([out[f"ghatl_{c}"] for c in "xyz"]) - gravity).max() <= 1e-12
     else:
         assert "ql_w" not in out
+
+
+@pytest.mark.parametrize("samples", [2.0, 0.8, 3.3])
+def test_a_late_sensor_measures_the_motion_that_long_ago(samples):
+    """ImuModel's delay line: a whole number of samples late, the signals are the motion's
+    shifted by that many samples, exactly; between samples, within 1e-4 rad/s and 1e-3 m/s²
+    of the closed-form motion's means over the interval that long ago (the line takes
+    them constant within each sample)."""
+    fs = 100.0
+    closed = PROFILES["sine_rotation"].motion({"inclination_deg": 20.0})
+    motion = closed.generate(30.0, fs)
+    latency = samples / fs
+    gyr, acc = ImuModel(latency=latency).delayed(motion.gyr, motion.acc, fs)
+    if samples.is_integer():
+        n = int(samples)
+        assert (gyr[n:] == motion.gyr[:-n]).all() and (acc[n:] == motion.acc[:-n]).all()
+        assert (gyr[:n] == motion.gyr[0]).all()  # before the start: the first sample
+    t = np.arange(1, len(motion.gyr) + 1) / fs
+    late_gyr, late_acc, _ = closed.at(t - latency, 1.0 / fs)
+    start = int(np.ceil(samples)) + 1
+    assert np.abs(gyr[start:] - late_gyr[start:]).max() < 1e-4
+    assert np.abs(acc[start:] - late_acc[start:]).max() < 1e-3
