@@ -17,7 +17,7 @@ from .heading import heading_step
 from .heading import initial_state as heading_initial_state
 from .heading import resolve as heading_resolve
 from .jit import kernel
-from .latency import carry_forward, check_latency
+from .timing import carry_forward, check_gyr_samples, check_latency
 from .methods import method as get_method, stepper
 from .quaternion import quat_euler_zyx
 from .sensor_frame import SensorFrameStepper, sensor_frame_step, start_gravity
@@ -48,7 +48,7 @@ def _finite_inputs(io):
 def _write_outputs(io, q, heading_state, heading_coef, heading, latency):
     """io[10:13] holds ĝ: normalise it; q, turned to the magnetometer's heading when asked
     (io[16:19] not finite or all 0: no new field sample), both carried forward over latency
-    (s) with the gyro in io[0:3] (blocks.latency), and q's Euler angles into io[6:10],
+    (s) with the gyro in io[0:3] (blocks.timing), and q's Euler angles into io[6:10],
     io[13:16]."""
     norm = math.sqrt(io[10] * io[10] + io[11] * io[11] + io[12] * io[12])
     for i in range(3):
@@ -91,13 +91,15 @@ class OnlineEstimator:
     batch path's mag argument), outputs come from io[6:16] (see IO_*). gyro_offset=True:
     the gyro offset is estimated and removed first (blocks.gyro_offset, as the batch
     path's gyro_offset argument). latency (s): the outputs are carried forward over the
-    IMU's delay (blocks.latency, as the batch path's latency argument). The filter starts
+    IMU's delay (blocks.timing, as the batch path's latency argument); gyr_samples "point":
+    each gyro input is the rate at the sample's time, averaged with the last finite one
+    into the mean over the sample time (blocks.timing.interval_means). The filter starts
     at rest on the first accelerometer sample with non-zero norm, as the batch path starts
     on its first sample; until then `ready` is False.
     """
 
     def __init__(self, method: str = "wiener", params: Mapping[str, float] | None = None, heading: bool = False,
-                 gyro_offset: bool = False, latency: float = 0.0):
+                 gyro_offset: bool = False, latency: float = 0.0, gyr_samples: str = "mean"):
         params, offset_params, heading_params = split_params(method, params, gyro_offset, heading)
         m = get_method(method)
         m.runs_kernel(m.resolve(params))  # refuse bad parameters now
@@ -107,6 +109,7 @@ class OnlineEstimator:
         self.heading = heading
         self.gyro_offset = gyro_offset
         self.latency = check_latency(latency)
+        self.point_samples = check_gyr_samples(gyr_samples) == "point"
         self.offset = np.zeros((2, 3))  # offset estimate (rad/s) and its variance ((rad/s)²)
         self.io = np.zeros(19)
         self._Ts = None
@@ -115,6 +118,7 @@ class OnlineEstimator:
     def reset(self) -> None:
         """Forget all samples."""
         self.state = None
+        self._last_gyr = None  # the last finite gyro input (point samples)
         self._quat = np.zeros((1, 4))
         self._heading_state = heading_initial_state()
         self.io[IO_OUTPUTS] = (1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0)
@@ -149,6 +153,11 @@ class OnlineEstimator:
             if self.gyro_offset:
                 self._offset_coef = offset_coefficients(self._offset_params, Ts)
 
+        if self.point_samples and np.isfinite(self.io[0:3]).all():
+            raw = self.io[0:3].copy()
+            if self._last_gyr is not None:
+                self.io[0:3] = 0.5 * (raw + self._last_gyr)
+            self._last_gyr = raw
         starting = self.state is None
         if starting:
             if not (np.isfinite(self.io[IO_INPUTS]).all() and np.any(self.io[3:6])):

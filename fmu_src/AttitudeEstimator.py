@@ -1,6 +1,7 @@
 """AttitudeEstimator.fmu: the project's attitude estimators as an FMI 2.0 co-simulation FMU.
 
-Each doStep(t, h) takes gyr (mean rate over (t, t+h]) and acc, mag at t+h, and steps the
+Each doStep(t, h) takes gyr (mean rate over (t, t+h], or with gyr_samples "point" the
+rate at t+h) and acc, mag at t+h, and steps the
 same compiled block as `attitude estimate` (blocks.online.OnlineEstimator). The tuning
 parameters are those of every method and of the gyro-offset and heading estimators
 (blocks.stages). A parameter at its start value means "the default": the start value is
@@ -40,7 +41,8 @@ class AttitudeEstimator(ProjectSlave):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        self.vector("gyr", (0.0, 0.0, 0.0), "rad/s", "gyro {c}, mean rate over the step", IN)
+        self.vector("gyr", (0.0, 0.0, 0.0), "rad/s", "gyro {c}, mean rate over the step (gyr_samples mean) "
+                    "or the rate at its end (point)", IN)
         self.vector("acc", (0.0, 0.0, 9.81), "m/s2", "specific force {c} at the end of the step", IN)
         self.vector("mag", (0.0, 0.0, 0.0), "uT", "magnetic field {c}; all 0: no magnetometer (heading from the gyro); NaN: no sample this step", IN)
         self.vector("q", (1.0, 0.0, 0.0, 0.0), "1", "orientation quaternion {c}, sensor -> earth (ENU)", OUT, "wxyz")
@@ -56,6 +58,9 @@ class AttitudeEstimator(ProjectSlave):
         self.parameter("gyro_offset", "on", "on (default, as attitude estimate): estimate and remove the gyro offset "
                        "(at rest and while moving); off: for a gyro without offset")
         self.real("Ts", 0.01, "s", "sample time the estimator expects (other step sizes are re-discretised)", PAR)
+        self.parameter("gyr_samples", "mean", "mean: gyr is the mean rate over the step (the FMI convention of "
+                       "MotionProfile and ImuSensor); point: the rate at the step's end (most models' outputs), "
+                       "averaged with the last one")
         self.real("latency", 0.0, "s", "the IMU's delay behind the motion (its filters' group delay, gyr taken as the "
                   "mean rate over the step); q and g are carried forward over it with the gyro", PAR)
         for name, (unit, doc, start) in tuning_parameters().items():
@@ -77,7 +82,8 @@ class AttitudeEstimator(ProjectSlave):
                   if getattr(self, name) != start}
         try:
             self.estimator = OnlineEstimator(self.method, params, heading=self.heading == "mag",
-                                             gyro_offset=self.gyro_offset == "on", latency=self.latency)
+                                             gyro_offset=self.gyro_offset == "on", latency=self.latency,
+                                             gyr_samples=self.gyr_samples)
         except ValueError as exc:
             self.fail(f"invalid parameter: {exc}")
 

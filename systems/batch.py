@@ -11,7 +11,7 @@ from scipy.spatial.transform import Rotation
 
 from blocks.gyro_offset import correct as correct_gyro
 from blocks.heading import with_magnetometer
-from blocks.latency import carry_forward_rows, check_latency
+from blocks.timing import carry_forward_rows, check_gyr_samples, check_latency, interval_means
 from blocks.stages import split_params
 from blocks.methods import METHODS, KernelStepper, method as get_method, stepper
 from blocks.sensor_frame import start_gravity, time_reversed
@@ -59,6 +59,7 @@ def check_imu(gyr, acc, fs: float) -> tuple[np.ndarray, np.ndarray]:
 def estimate(
     gyr, acc, fs: float, method: str = "wiener", params: Mapping[str, float] | None = None,
     initial_gravity=None, offline: bool = False, gyro_offset: bool = False, mag=None, latency: float = 0.0,
+    gyr_samples: str = "mean",
 ) -> AttitudeEstimate:
     """Estimate attitude over a recording: gyr N×3 rad/s, acc N×3 m/s², fs in Hz.
 
@@ -74,10 +75,14 @@ def estimate(
     `offset`). mag (N×3, µT; rows with a NaN are missing samples): heading from the
     magnetometer with a guard against disturbances (blocks.heading); without it the
     heading is the gyro's (6D). latency (s): the IMU's delay behind the motion; the
-    estimate is carried forward over it with the (offset-free) gyro (blocks.latency).
+    estimate is carried forward over it with the (offset-free) gyro (blocks.timing).
+    gyr_samples: "mean" (the project's convention: sample k is the mean rate over the
+    sample time before it) or "point" (the rate at t_k, turned into means first).
     """
     gyr, acc = check_imu(gyr, acc, fs)
     latency = check_latency(latency)
+    if check_gyr_samples(gyr_samples) == "point":
+        gyr = interval_means(gyr)
     params, offset_params, heading_params = split_params(method, params, gyro_offset, mag is not None)
     offset = None
     if gyro_offset:

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from blocks.latency import check_latency
+from blocks.timing import GYR_SAMPLES, check_latency
 from blocks.methods import METHODS
 from blocks.methods import method as known_method
 from blocks.stages import ESTIMATORS
@@ -64,6 +64,10 @@ def _add_input_flags(parser) -> None:
     parser.add_argument("--max-gap", type=float, default=MAX_GAP_S, metavar="S",
                         help="longest run of samples missing from a CSV's time stamps that is filled in "
                              f"(gyro and accelerometer interpolated; default {MAX_GAP_S:g} s)")
+    parser.add_argument("--gyr-samples", default="mean", choices=list(GYR_SAMPLES),
+                        help="mean: a gyro sample is the mean rate over the sample time before it (default; the "
+                             "project's convention); point: the rate at the sample's time (simulations that sample "
+                             "ω(t), most IMU drivers), turned into means by the trapezoid")
     parser.add_argument("--latency", type=float, default=0.0, metavar="S",
                         help="the IMU's delay behind the motion in seconds (its filters' group delay; a gyro sample "
                              "taken as the mean rate over the sample time before it): estimates are carried forward "
@@ -175,7 +179,7 @@ def cmd_estimate(args) -> int:
             print(f"attitude: note: {note}", file=sys.stderr)
     result = estimate(rec.gyr, rec.acc, rec.fs, args.method, dict(args.param), offline=args.offline,
                       gyro_offset=args.gyro_offset == "on", mag=rec.mag if args.heading == "mag" else None,
-                      latency=args.latency)
+                      latency=args.latency, gyr_samples=args.gyr_samples)
     progress(f"estimated with {args.method}{' --offline' if args.offline else ''}")
     rows = slice(None) if rec.filled is None else ~rec.filled  # the input's rows, not those filled in
     write_estimate(args.out, rec.t[rows], result.quat[rows], result.up[rows])
@@ -202,7 +206,7 @@ def cmd_evaluate(args) -> int:
                            "install them with: pip install 'attitude-fmu[peers]'") from None
     result = evaluate(args.files, args.method, dict(args.param), args.offline, args.gyro_offset == "on",
                       args.heading == "mag", start_in_movement=args.start_in_movement,
-                      read_options=_read_options(args), latency=args.latency)
+                      read_options=_read_options(args), latency=args.latency, gyr_samples=args.gyr_samples)
     if args.json:
         print(json.dumps(result, indent=2))
         return 0
@@ -221,7 +225,8 @@ def cmd_plot(args) -> int:
 
     _check_out(args.out)
     result = plot_recording(args.file, args.out, args.method, dict(args.param), args.offline,
-                            args.gyro_offset == "on", args.heading == "mag", _read_options(args), args.latency)
+                            args.gyro_offset == "on", args.heading == "mag", _read_options(args), args.latency,
+                            args.gyr_samples)
     heading = f", heading RMSE {result['heading_rmse_deg']:.2f}°" if "heading_rmse_deg" in result else ""
     print(f"attitude: wrote {args.out} (inclination RMSE {result['inclination_rmse_deg']:.2f}°{heading})",
           file=sys.stderr)

@@ -8,7 +8,7 @@ import numpy as np
 from blocks import gyro_offset
 from blocks.heading import heading_system
 from blocks.heading import initial_state as heading_initial_state
-from blocks.latency import latency_system
+from blocks.timing import latency_system
 from blocks.methods import estimator_system, stepper
 from blocks.quaternion import quat_rotate
 from blocks.sensor_frame import GRAVITY_OUTPUTS, QUAT_NAMES
@@ -54,7 +54,7 @@ def closed_loop(motion: HumanMotion, imu: ImuModel, fs: float, method: str = "wi
     estimator's orientation and the magnetometer. Inputs: NOISE_INPUTS (unit-normal
     samples); outputs: incl_err (rad), ghat_*, q_*, with offset the gyro offset estimate
     offset_* (rad/s), with heading qh_* and the hard-iron estimate mag_offset_* (µT);
-    latency (s, non-zero): the latency stage (blocks.latency) on the last orientation and
+    latency (s, non-zero): the latency stage (blocks.timing) on the last orientation and
     ghat_*, outputs ql_* and ghatl_*.
     """
     dt = 1.0 / fs

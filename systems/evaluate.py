@@ -5,12 +5,13 @@ from __future__ import annotations
 
 import math
 import sys
+from dataclasses import replace
 
 import numpy as np
 from scipy.optimize import minimize_scalar
 from scipy.spatial.transform import Rotation
 
-from blocks.latency import carry_forward_rows, check_latency
+from blocks.timing import carry_forward_rows, check_gyr_samples, check_latency, interval_means
 
 from .batch import estimate
 from .compare import peer_quaternions
@@ -32,7 +33,7 @@ def errors_on_movement(quat, rec: Recording) -> dict:
 
 
 def imu_latency(rec: Recording) -> float | None:
-    """The IMU's latency behind its reference (s, in blocks.latency's convention): the
+    """The IMU's latency behind its reference (s, in blocks.timing's convention): the
     shift of the reference's mean rate over each sample time that best matches the gyro,
     least squares over the movement phase (at most LATENCY_SAMPLES of it) within
     ±LATENCY_SEARCH_S: a grid of at most 201 shifts, then a bounded search around the best.
@@ -68,7 +69,7 @@ def evaluate_recording(rec: Recording, method: str = "wiener", params=None, offl
     """{method label: {metric: value}} for one recording; with a magnetometer (and use_mag)
     the method's heading comes from it, and vqf's 9D estimate is added as "vqf_9d".
     latency (s): every estimate, the peers' too, is carried forward over the IMU's delay
-    (blocks.latency; the peers' with the raw gyro)."""
+    (blocks.timing; the peers' with the raw gyro)."""
     rec.evaluated()  # refuses a recording without a usable reference before any work
     import vqf as vqf_module  # peers: the test extra (or [peers])
 
@@ -98,19 +99,24 @@ def evaluate_recording(rec: Recording, method: str = "wiener", params=None, offl
 
 def evaluate(paths, method: str = "wiener", params=None, offline: bool = False, gyro_offset: bool = True,
              use_mag: bool = True, progress: bool = True, start_in_movement: float | None = None,
-             read_options=None, latency: float = 0.0) -> dict:
+             read_options=None, latency: float = 0.0, gyr_samples: str = "mean") -> dict:
     """{"recordings": {name: {label: metrics}}, "mean": {label: metrics}, "imu_latency_s":
     {name: seconds or None}} over the files (imu_latency: the IMU's delay behind the
     reference, measured, whatever latency (s) the estimates were carried forward by);
+    gyr_samples "point": every recording's gyro is turned into interval means first
+    (blocks.timing.interval_means), for the peers and the latency measured as well;
     start_in_movement (s): cut each recording to begin that long into its movement phase;
     read_options: keyword arguments of read_recording (units, fs, max_gap). Every file is
     read and checked first. A recording's name is its file's stem, or its path where
     stems repeat. progress also prints how each file was read where it matters (time
     stamps, no movement flag)."""
     check_latency(latency)
+    point = check_gyr_samples(gyr_samples) == "point"
     read = []  # every file read and checked before any estimate: a bad last file costs nothing
     for path in paths:
         rec = read_recording(path, **(read_options or {}))
+        if point:
+            rec = replace(rec, gyr=interval_means(rec.gyr))
         if start_in_movement is not None:
             rec = rec.into_movement(start_in_movement)
         rec.evaluated()

@@ -17,14 +17,15 @@ from .recording import RecordingError, read_recording
 
 
 def plot_recording(path, out, method: str = "wiener", params=None, offline: bool = False,
-                   gyro_offset: bool = True, heading: bool = True, read_options=None, latency: float = 0.0) -> dict:
+                   gyro_offset: bool = True, heading: bool = True, read_options=None, latency: float = 0.0,
+                   gyr_samples: str = "mean") -> dict:
     """Draw the error of method on a recording with a reference into out (PNG): the
     inclination error over time, with heading (and a magnetometer in the recording) the
     heading error with the samples the disturbance guard refused shaded and the times a
     hard-iron offset was taken or dropped marked, and the tilt error's spectrum beside eq. 42.
     Returns the inclination and (with the magnetometer) heading RMSE (deg) over the
     movement phase (Recording.evaluated). read_options: keyword arguments of read_recording;
-    latency (s): as systems.batch.estimate's."""
+    latency (s) and gyr_samples: as systems.batch.estimate's."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -36,7 +37,7 @@ def plot_recording(path, out, method: str = "wiener", params=None, offline: bool
         raise RecordingError(f"{rec.name}: too few valid reference samples to plot")
     mag = rec.mag if heading else None
     est = estimate(rec.gyr, rec.acc, rec.fs, method, params, offline=offline, gyro_offset=gyro_offset, mag=mag,
-                   latency=latency)
+                   latency=latency, gyr_samples=gyr_samples)
     inclination, heading_error = np.full(len(rec.gyr), np.nan), np.full(len(rec.gyr), np.nan)
     _, heading_error[valid], inclination[valid] = np.degrees(quaternion_errors(est.quat[valid], rec.quat_ref[valid]))
     # horizontal earth-frame components of the estimated up: small-angle tilt errors, rad

@@ -20,7 +20,7 @@ class ImuModel:
     rate component; 1 = 100 %); acc_noise:
     accelerometer white-noise density, m/s²/√Hz; acc_offset: constant accelerometer
     offset, m/s² (3); latency: how long the measured gyro and accelerometer lag the motion,
-    s (see delay_step; blocks.latency compensates it). Noise enters as unit-normal
+    s (see delay_step; blocks.timing compensates it). Noise enters as unit-normal
     samples, 6 per sample (gyro, acc).
     """
 

@@ -7,7 +7,7 @@ from scipy.spatial.transform import Rotation
 
 from blocks import gyro_offset
 from blocks.heading import with_magnetometer
-from blocks.latency import carry_forward_rows
+from blocks.timing import carry_forward_rows
 from systems.batch import estimate
 from systems.diagram import simulate_closed_loop
 from systems.errors import inclination_error

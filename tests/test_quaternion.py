@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from blocks.latency import carry_forward_rows
+from blocks.timing import carry_forward_rows
 from blocks.quaternion import level_quat, quat_multiply, quat_normalized, quat_rotate, rotvec_quat
 
 RNG = np.random.default_rng(7)
@@ -41,7 +41,7 @@ def test_level_quat_is_the_smallest_rotation_onto_up(u):
 
 
 def test_carry_forward_matches_scipy():
-    """blocks.latency: q ⊗ exp(ω·L) and the up-vector in the sensor frame L later."""
+    """blocks.timing: q ⊗ exp(ω·L) and the up-vector in the sensor frame L later."""
     rot = Rotation.random(40, random_state=3)
     gyr, gravity, latency = RNG.normal(scale=3.0, size=(40, 3)), RNG.normal(scale=9.81, size=(40, 3)), 0.004
     quat, up = rot.as_quat(scalar_first=True), gravity.copy()

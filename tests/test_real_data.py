@@ -4,6 +4,7 @@ benchmark, tests/test_broad_benchmark.py, that skips without the files)."""
 import json
 import math
 import shutil
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -17,6 +18,7 @@ from blocks.gyro_offset import coefficients as offset_coefficients
 from blocks.gyro_offset import correct as correct_gyro
 from blocks.gyro_offset import resolve as resolve_offset_params
 from blocks.heading import with_magnetometer
+from blocks.timing import interval_means
 from systems import experiments as ex
 from systems.batch import estimate
 from systems.cli import main
@@ -298,7 +300,7 @@ def _delayed_imu(motion, duration: float, delay: float):
 def test_latency_carries_a_delayed_imu_onto_the_motion(offline):
     """An IMU 8 ms (0.8 samples) behind a closed-form pitching motion: the estimate lags
     with it, its inclination error the rate times the delay (RMS of |ω|·d, within 5 %).
-    Carried forward over the delay (blocks.latency), what is left is the extrapolation's
+    Carried forward over the delay (blocks.timing), what is left is the extrapolation's
     second-order term: the gyro's last sample is the rate (d + Ts)/2 before the middle of
     the delay, so |ω̇|·d·(d + Ts)/2 (within 10 %), under 3 % of the lag's error."""
     delay = 0.008
@@ -318,6 +320,57 @@ def test_latency_carries_a_delayed_imu_onto_the_motion(offline):
           f"{math.degrees(errors[delay]):.5f}° with latency compensation (|ω̇|·d·(d + Ts)/2 {math.degrees(left):.5f}°)")
     assert errors[0.0] == pytest.approx(lag, rel=0.05)
     assert errors[delay] == pytest.approx(left, rel=0.1) and errors[delay] < 0.03 * errors[0.0]
+
+
+def test_point_samples_of_the_rate_are_turned_into_interval_means():
+    """A simulation that samples ω(t_k) and f(t_k) (not the means over each sample time)
+    of a ±10° pitch at 0.5 Hz (Ω = π rad/s), 100 Hz: integrated as means, the gyro's
+    frame leads by Ts/2 and the filter (eq. 34 at ω_g = 1 rad/s) passes that lead on
+    through its complementary high-pass 1 − B(jΩ): a tilt RMS of |1 − B(jΩ)|·|ω|·Ts/2
+    (within 3 %). With gyr_samples "point" it is under 2 % of that. imu_latency sees the
+    samples Ts/2 ahead of the reference, and on time once turned into means."""
+    motion = PROFILES["sine_rotation"].motion({"inclination_deg": 20.0})
+    t = np.arange(1, int(60 * FS) + 1) / FS
+    gyr, acc, quat = motion.at(t, 1e-7)  # the rate and specific force at t_k
+    up = Rotation.from_quat(quat, scalar_first=True).inv().apply([0.0, 0.0, 1.0])
+    settled = slice(int(20 * FS), None)
+    params = {"omega_g": 1.0}
+    errors = {samples: rms(inclination_error(estimate(gyr, acc, FS, params=params, gyr_samples=samples).up[settled],
+                                             up[settled])) for samples in ("mean", "point")}
+    s = 1j * math.pi
+    passed = abs(1.0 - 1.0 / (s * s + math.sqrt(2.0) * s + 1.0))
+    lead = passed * rms(np.linalg.norm(gyr[settled], axis=1) / FS / 2)
+    print(f"tilt RMS: point samples as means {math.degrees(errors['mean']):.4f}° (|1 − B|·|ω|·Ts/2 "
+          f"{math.degrees(lead):.4f}°), turned into means {math.degrees(errors['point']):.5f}°")
+    assert errors["mean"] == pytest.approx(lead, rel=0.03) and errors["point"] < 0.02 * lead
+    rec = Recording("point", FS, gyr, acc, t, quat_ref=quat, movement=t > 20.0)
+    assert imu_latency(rec) == pytest.approx(-0.5 / FS, abs=1e-4)
+    assert imu_latency(replace(rec, gyr=interval_means(gyr))) == pytest.approx(0.0, abs=1e-4)
+
+
+def test_gyr_samples_point_reaches_evaluate_estimate_and_the_peers(tmp_path, capsys):
+    """--gyr-samples point on a recording of point samples: evaluate measures the IMU on
+    time instead of Ts/2 ahead, and every method's error falls, the peers' too (they get
+    the same interval means); estimate writes the batch path's estimate."""
+    motion = PROFILES["coning"].motion()
+    t = np.arange(1, int(60 * FS) + 1) / FS
+    gyr, acc, quat = motion.at(t, 1e-7)
+    _broad_like(tmp_path / "point.mat", Motion(FS, quat, gyr, acc))
+    runs = {}
+    for samples in ("mean", "point"):
+        assert main(["evaluate", "--json", "--gyr-samples", samples, str(tmp_path / "point.mat")]) == 0
+        runs[samples] = json.loads(capsys.readouterr().out)
+    assert runs["mean"]["imu_latency_s"]["point"] == pytest.approx(-0.5 / FS, abs=2e-4)
+    assert runs["point"]["imu_latency_s"]["point"] == pytest.approx(0.0, abs=2e-4)
+    for label in ("wiener", "vqf", "vqf_offline"):
+        assert (runs["point"]["mean"][label]["inclination_rmse_deg"]
+                < 0.5 * runs["mean"]["mean"][label]["inclination_rmse_deg"]), label
+    out = tmp_path / "est.csv"
+    assert main(["estimate", str(tmp_path / "point.mat"), "--out", str(out), "--gyr-samples", "point"]) == 0
+    rec = read_recording(tmp_path / "point.mat")
+    ref = estimate(rec.gyr, rec.acc, FS, gyro_offset=True, mag=rec.mag, gyr_samples="point")
+    written = np.loadtxt(out, delimiter=",", skiprows=1)
+    assert np.abs(written[:, 1:5] - ref.quat).max() < 1e-9
 
 
 @pytest.mark.parametrize("delay", [0.0037, -0.002])
