@@ -211,12 +211,14 @@ def cmd_evaluate(args) -> int:
         print(json.dumps(result, indent=2))
         return 0
     labels = list(result["mean"])
-    print("RMSE over the movement phase, degrees: inclination / heading / total")
-    print(f"{'recording':>45} " + " ".join(f"{label:>22}" for label in labels))
+    print("RMSE over the movement phase, degrees: inclination / heading / total; IMU lag behind the reference, ms")
+    print(f"{'recording':>45} " + " ".join(f"{label:>22}" for label in labels) + f" {'lag':>6}")
     rows = list(result["recordings"].items()) + [("mean", result["mean"])]
     for name, table in rows:
         cells = " ".join(f"{'/'.join(format(table[l][m], '.2f') for m in reversed(METRICS)):>22}" for l in labels)
-        print(f"{name:>45} {cells}")
+        lag = result["imu_latency_s"].get(name)
+        print(f"{name:>45} {cells} {'' if name == 'mean' else '     —' if lag is None else format(1e3 * lag, '6.2f')}"
+              .rstrip())
     return 0
 
 
