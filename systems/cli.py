@@ -69,9 +69,10 @@ def _add_input_flags(parser) -> None:
                              "project's convention); point: the rate at the sample's time (simulations that sample "
                              "ω(t), most IMU drivers), turned into means by the trapezoid")
     parser.add_argument("--latency", type=float, default=0.0, metavar="S",
-                        help="the IMU's delay behind the motion in seconds (its filters' group delay; a gyro sample "
-                             "taken as the mean rate over the sample time before it): estimates are carried forward "
-                             "over it with the gyro (default 0; attitude evaluate measures it against the reference)")
+                        help="the IMU's delay behind the motion in seconds (its filters' group delay), counted in "
+                             "the means the estimator takes (point samples taken S late, with --gyr-samples point): "
+                             "estimates are carried forward over it with the gyro (default 0; attitude evaluate "
+                             "measures it against the reference)")
 
 
 def _read_options(args) -> dict:
