@@ -17,7 +17,7 @@ from .heading import heading_step
 from .heading import initial_state as heading_initial_state
 from .heading import resolve as heading_resolve
 from .jit import kernel
-from .timing import carry_forward, check_gyr_samples, check_latency
+from .timing import carry_forward, check_gyr_samples, check_latency, interval_mean
 from .methods import method as get_method, stepper
 from .quaternion import quat_euler_zyx
 from .sensor_frame import SensorFrameStepper, sensor_frame_step, start_gravity
@@ -156,7 +156,7 @@ class OnlineEstimator:
         if self.point_samples and np.isfinite(self.io[0:3]).all():
             raw = self.io[0:3].copy()
             if self._last_gyr is not None:
-                self.io[0:3] = 0.5 * (raw + self._last_gyr)
+                self.io[0:3] = interval_mean(self._last_gyr, raw)
             self._last_gyr = raw
         starting = self.state is None
         if starting:

@@ -37,11 +37,17 @@ def check_gyr_samples(value: str) -> str:
     return value
 
 
+def interval_mean(before, now):
+    """The mean rate over the sample time between two point samples of it (rad/s): the
+    trapezoid (ω_k−1 + ω_k)/2."""
+    return 0.5 * (before + now)
+
+
 def interval_means(gyr) -> np.ndarray:
-    """Point samples of the rate (N×3, rad/s, at t_k) as means over (t_k−1, t_k]: the
-    trapezoid (ω_k−1 + ω_k)/2; the first sample, with nothing before it, stays."""
+    """Point samples of the rate (N×3, rad/s, at t_k) as means over (t_k−1, t_k]
+    (interval_mean); the first sample, with nothing before it, stays."""
     gyr = np.array(gyr, dtype=float)
-    gyr[1:] = 0.5 * (gyr[1:] + gyr[:-1])  # right side evaluated first: the raw samples
+    gyr[1:] = interval_mean(gyr[:-1], gyr[1:])  # right side evaluated first: the raw samples
     return gyr
 
 

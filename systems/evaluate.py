@@ -48,10 +48,10 @@ def imu_latency(rec: Recording) -> float | None:
     if len(k) < rec.fs:
         return None
     k = k[::-(-len(k) // LATENCY_SAMPLES)]
-    gyr = rec.gyr[k]
+    gyr, index = rec.gyr[k], np.arange(len(rate))
 
     def mismatch(lag):  # gyro sample k against the reference's rate at k − lag (samples)
-        shifted = np.column_stack([np.interp(k - lag, np.arange(len(rate)), rate[:, i]) for i in range(3)])
+        shifted = np.column_stack([np.interp(k - lag, index, rate[:, i]) for i in range(3)])
         return float(np.nanmean(np.sum((gyr - shifted) ** 2, axis=1)))
 
     reach = LATENCY_SEARCH_S * rec.fs
