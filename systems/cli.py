@@ -91,7 +91,8 @@ def build_parser() -> argparse.ArgumentParser:
         formatter_class=argparse.RawDescriptionHelpFormatter,
         epilog="methods and estimators, and their parameters (a name under several sets it in each):\n" + _method_help(),
     )
-    est.add_argument("input", help="CSV (t,gyr_x,gyr_y,gyr_z,acc_x,acc_y,acc_z[,mag_x,mag_y,mag_z]) or BROAD .mat")
+    est.add_argument("input", help="CSV (t,gyr_x,gyr_y,gyr_z,acc_x,acc_y,acc_z[,mag_x,mag_y,mag_z]; "
+                     "separated by commas, semicolons or tabs) or BROAD .mat")
     est.add_argument("--out", required=True, help="output CSV: t,q_w,q_x,q_y,q_z,g_x,g_y,g_z")
     est.add_argument("--method", default="wiener", choices=sorted(METHODS))
     est.add_argument("--param", type=_param, action="append", default=[], metavar="NAME=VALUE",

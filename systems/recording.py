@@ -11,6 +11,7 @@ import numpy as np
 
 from blocks.earth_filters import STANDARD_GRAVITY
 
+DELIMITERS = (",", ";", "\t")  # the header's most frequent one; with ";" or a tab, "," is a decimal comma
 IMU_COLUMNS = ("gyr_x", "gyr_y", "gyr_z", "acc_x", "acc_y", "acc_z")
 MAG_COLUMNS = ("mag_x", "mag_y", "mag_z")
 REF_COLUMNS = ("ref_q_w", "ref_q_x", "ref_q_y", "ref_q_z")  # optional reference orientation, sensor → earth
@@ -131,7 +132,9 @@ def field_norm_note(rec: Recording) -> str | None:
 
 def _read_csv(path: Path, fs: float | None, max_gap: float, t_scale: float) -> Recording:
     with path.open(newline="", encoding="utf-8-sig") as fh:  # a spreadsheet's byte-order mark is not a name
-        header = next(csv.reader(fh), None)
+        first = fh.readline()
+    delimiter = max(DELIMITERS, key=first.count)
+    header = next(csv.reader([first], delimiter=delimiter), None)
     if not header:
         raise RecordingError(f"{path}: empty file; expected a header t,{','.join(IMU_COLUMNS)}")
     header = [h.strip() for h in header]
@@ -148,7 +151,9 @@ def _read_csv(path: Path, fs: float | None, max_gap: float, t_scale: float) -> R
     try:
         with warnings.catch_warnings():  # no rows: said below, not as numpy's warning
             warnings.simplefilter("ignore", UserWarning)
-            data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2, dtype=float)
+            with path.open(encoding="utf-8-sig") as fh:
+                rows = fh if delimiter == "," else (line.replace(",", ".") for line in fh)
+                data = np.loadtxt(rows, delimiter=delimiter, skiprows=1, ndmin=2, dtype=float)
     except ValueError as exc:
         raise RecordingError(f"{path}: unreadable number ({exc})") from None
     if data.shape[0] == 0 or data.shape[1] != len(header):
@@ -255,6 +260,8 @@ def _read_mat(path: Path, fs: float | None) -> Recording:
 
     try:
         mat = loadmat(path, squeeze_me=True)
+    except NotImplementedError:  # scipy's answer to a v7.3 file
+        mat = _read_mat_v73(path)
     except Exception as exc:  # scipy raises several types for damaged files
         raise RecordingError(f"{path}: not a readable MATLAB file ({exc})") from None
     missing = [k for k in ("imu_gyr", "imu_acc", *(() if fs else ("sampling_rate",))) if k not in mat]
@@ -283,6 +290,19 @@ def _read_mat(path: Path, fs: float | None) -> Recording:
         path.stem, fs, gyr, acc, np.arange(1, n + 1) / fs, optional("imu_mag", 3),
         optional("opt_quat", 4), None if movement is None else _flag(path, "movement", movement),
     )
+
+
+def _read_mat_v73(path: Path) -> dict:
+    """The numeric variables of a MATLAB v7.3 file (HDF5), as loadmat(squeeze_me=True)
+    gives them from older versions: HDF5 holds MATLAB's arrays transposed."""
+    import h5py
+
+    try:
+        with h5py.File(path, "r") as f:
+            return {name: np.squeeze(np.asarray(item).T) for name, item in f.items()
+                    if isinstance(item, h5py.Dataset) and item.dtype.kind in "fiub"}
+    except OSError as exc:
+        raise RecordingError(f"{path}: not a readable MATLAB v7.3 file ({exc})") from None
 
 
 def _check_rate(name, fs: float) -> None:

@@ -13,7 +13,7 @@ from systems.batch import estimate
 from systems.cli import main
 from systems.errors import inclination_error, rms
 from systems.motion import ClosedFormMotion, HumanMotion
-from systems.recording import IMU_COLUMNS, REF_COLUMNS, read_recording
+from systems.recording import IMU_COLUMNS, REF_COLUMNS, RecordingError, read_recording
 from systems.sensor_model import ImuModel
 
 FS = 100.0
@@ -58,16 +58,25 @@ def test_rounded_and_jittering_time_stamps_give_the_rate_of_the_whole_span(tmp_p
         assert ("off a uniform grid; the samples are taken as uniform at 285.7 Hz" in err) == noted, err
 
 
-def test_a_spreadsheets_header_reads_as_ours(tmp_path, recording):
-    """A byte-order mark and spaces around the names (as spreadsheets export) change nothing."""
+def test_a_spreadsheets_header_and_separators_read_as_ours(tmp_path, recording):
+    """A byte-order mark and spaces around the names (as spreadsheets export), semicolons
+    with decimal commas (a spreadsheet in a German locale) and tabs change nothing."""
     _, gyr, acc, _ = recording
     t = np.arange(1, 101) / FS
     _write(tmp_path / "plain.csv", t, gyr[:100], acc[:100])
     lines = (tmp_path / "plain.csv").read_text().splitlines()
-    header = "\ufeff" + ", ".join(lines[0].split(","))
-    (tmp_path / "sheet.csv").write_text("\n".join([header, *lines[1:]]) + "\n", encoding="utf-8")
-    plain, sheet = read_recording(tmp_path / "plain.csv"), read_recording(tmp_path / "sheet.csv")
-    assert sheet.fs == plain.fs and np.array_equal(sheet.gyr, plain.gyr) and np.array_equal(sheet.acc, plain.acc)
+    sheets = {
+        "sheet.csv": ["\ufeff" + ", ".join(lines[0].split(",")), *lines[1:]],
+        "semicolon.csv": [line.replace(",", ";").replace(".", ",") for line in lines],
+        "tab.tsv": [line.replace(",", "\t") for line in lines],
+    }
+    plain = read_recording(tmp_path / "plain.csv")
+    for name, sheet_lines in sheets.items():
+        (tmp_path / name).write_text("\n".join(sheet_lines) + "\n", encoding="utf-8")
+        sheet = read_recording(tmp_path / name)
+        assert sheet.fs == plain.fs and np.array_equal(sheet.t, plain.t), name
+        assert np.array_equal(sheet.gyr, plain.gyr) and np.array_equal(sheet.acc, plain.acc), name
+    assert "," in sheets["semicolon.csv"][1]  # the decimal commas were there to be read
 
 
 def test_columns_it_cannot_use_are_refused_or_named(tmp_path, recording, capsys):
@@ -112,6 +121,39 @@ def test_mat_files_with_a_transposed_array_no_rate_or_no_magnetometer_sample(tmp
         outputs.append((np.loadtxt(tmp_path / f"{name}.csv", delimiter=",", skiprows=1), capsys.readouterr().err))
     assert np.array_equal(outputs[0][0], outputs[1][0])
     assert "the magnetometer has no sample (NaN throughout); heading from the gyro" in outputs[0][1]
+
+
+def _savemat_v73(path, variables):
+    """A MATLAB v7.3 file as MATLAB writes one: HDF5 behind a 512-byte block whose first 128
+    bytes are the MAT header (version 0x0200), arrays stored transposed."""
+    import h5py
+
+    with h5py.File(path, "w", userblock_size=512) as f:
+        for name, value in variables.items():
+            f.create_dataset(name, data=np.atleast_2d(np.asarray(value, dtype=float)).T).attrs["MATLAB_class"] = b"double"
+    header = b"MATLAB 7.3 MAT-file, Platform: GLNXA64, Created on: Wed Nov 25 08:00:00 2026 HDF5 schema 1.00 ."
+    with open(path, "r+b") as fh:
+        fh.write(header.ljust(116) + bytes(8) + b"\x00\x02IM")
+
+
+def test_a_mat_file_of_matlab_v73_reads_as_an_older_one(tmp_path, recording):
+    """MATLAB v7.3 (HDF5, which scipy's loadmat does not read) gives the same recording as
+    the v5 file of the same variables, transposition and a scalar rate included; a file
+    that only claims to be v7.3 is refused with a message."""
+    motion, gyr, acc, _ = recording
+    n = 500
+    variables = {"imu_gyr": gyr[:n], "imu_acc": acc[:n], "sampling_rate": FS,
+                 "opt_quat": motion.quat[:n], "movement": np.arange(n) > 100}
+    savemat(tmp_path / "v5.mat", variables)
+    _savemat_v73(tmp_path / "v73.mat", variables)
+    old, new = read_recording(tmp_path / "v5.mat"), read_recording(tmp_path / "v73.mat")
+    assert new.fs == FS
+    for name in ("gyr", "acc", "t", "quat_ref", "movement"):
+        assert np.array_equal(getattr(new, name), getattr(old, name)), name
+    with open(tmp_path / "v73.mat", "r+b") as fh:  # the header stays, the HDF5 behind it goes
+        fh.truncate(600)
+    with pytest.raises(RecordingError, match="not a readable MATLAB v7.3 file"):
+        read_recording(tmp_path / "v73.mat")
 
 
 def test_time_stamps_in_milliseconds_need_their_unit(tmp_path, recording, capsys):
