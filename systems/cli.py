@@ -57,8 +57,9 @@ def _add_real_data_flags(parser) -> None:
 
 def _add_input_flags(parser) -> None:
     parser.add_argument("--fs", type=float, help="sample rate in Hz (required when a CSV has no t column)")
-    parser.add_argument("--gyr-unit", default="rad/s", choices=list(GYR_UNITS))
-    parser.add_argument("--acc-unit", default="m/s2", choices=list(ACC_UNITS))
+    parser.add_argument("--gyr-unit", default="rad/s", choices=list(GYR_UNITS), help="gyro unit (default rad/s)")
+    parser.add_argument("--acc-unit", default="m/s2", choices=list(ACC_UNITS),
+                        help="accelerometer unit (default m/s2; g and mg in standard gravity, 9.80665 m/s²)")
     parser.add_argument("--mag-unit", default="uT", choices=list(MAG_UNITS), help="magnetometer unit (default uT)")
     parser.add_argument("--t-unit", default="s", choices=list(T_UNITS), help="unit of a CSV's t column (default s)")
     parser.add_argument("--max-gap", type=float, default=MAX_GAP_S, metavar="S",

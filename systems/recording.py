@@ -17,8 +17,8 @@ MAG_COLUMNS = ("mag_x", "mag_y", "mag_z")
 REF_COLUMNS = ("ref_q_w", "ref_q_x", "ref_q_y", "ref_q_z")  # optional reference orientation, sensor → earth
 MOVEMENT_COLUMN = "movement"  # optional: 1 in the phase the errors are measured over, else 0
 OUTPUT_COLUMNS = ("t", "q_w", "q_x", "q_y", "q_z", "g_x", "g_y", "g_z")
-GYR_UNITS = {"rad/s": 1.0, "deg/s": math.pi / 180.0}
-ACC_UNITS = {"m/s2": 1.0, "g": STANDARD_GRAVITY}
+GYR_UNITS = {"rad/s": 1.0, "deg/s": math.pi / 180.0, "mdeg/s": math.pi / 180e3}
+ACC_UNITS = {"m/s2": 1.0, "g": STANDARD_GRAVITY, "mg": STANDARD_GRAVITY / 1e3}
 MAG_UNITS = {"uT": 1.0, "nT": 1e-3, "G": 100.0, "mG": 0.1}  # to µT
 T_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}  # to s
 RATE_RANGE_HZ = (1.0, 1e5)  # sample rates an IMU recording can have; outside, the time unit is wrong
@@ -109,7 +109,7 @@ def read_recording(path, fs: float | None = None, gyr_unit: str = "rad/s", acc_u
         rec.notes.append(f"{rec.name}: the magnetometer has no sample (NaN throughout); heading from the gyro")
     if rec.mag is not None:
         rec.mag = rec.mag * MAG_UNITS[mag_unit]
-    _check_values(rec)
+    _check_values(rec, gyr_unit, acc_unit)
     return rec
 
 
@@ -312,7 +312,13 @@ def _check_rate(name, fs: float) -> None:
                              f"are the time stamps in seconds? If not, pass --t-unit ({', '.join(T_UNITS)})")
 
 
-def _check_values(rec: Recording) -> None:
+def _unit_hint(flag: str, units: dict, given: str, value: float, plausible) -> str:
+    """The unit of `units` that would make value (read in `given`) plausible, as a hint."""
+    fits = [u for u, factor in units.items() if u != given and plausible(value / units[given] * factor)]
+    return f"; looks like {fits[0]}: pass {flag} {fits[0]}" if fits else ""
+
+
+def _check_values(rec: Recording, gyr_unit: str = "rad/s", acc_unit: str = "m/s2") -> None:
     for name in ("gyr", "acc"):
         a = getattr(rec, name)
         if a.ndim != 2 or a.shape[1] != 3 or len(a) != len(rec.gyr) or len(a) == 0:
@@ -325,15 +331,14 @@ def _check_values(rec: Recording) -> None:
     _check_rate(rec.name, rec.fs)
     peak = float(np.max(np.abs(rec.gyr)))
     if peak > MAX_GYRO_RAD_S:
-        raise RecordingError(
-            f"{rec.name}: gyro reaches {peak:.1f} rad/s, beyond any MEMS gyro; "
-            "the gyro columns look like deg/s: pass --gyr-unit deg/s"
-        )
+        hint = _unit_hint("--gyr-unit", GYR_UNITS, gyr_unit, peak, lambda p: p <= MAX_GYRO_RAD_S)
+        raise RecordingError(f"{rec.name}: gyro reaches {peak:.1f} rad/s read as {gyr_unit}, beyond any MEMS gyro{hint}")
     norm = float(np.median(np.linalg.norm(rec.acc, axis=1)))
-    if 0.5 < norm < 2.0:
-        raise RecordingError(f"{rec.name}: median accelerometer norm is {norm:.2f}: looks like g; pass --acc-unit g")
-    if not 4.0 < norm < 20.0:
-        raise RecordingError(f"{rec.name}: median accelerometer norm is {norm:.3g}, far from gravity; expected m/s²")
+    plausible = lambda n: 4.0 < n < 20.0  # m/s², gravity and a person's motion
+    if not plausible(norm):
+        hint = _unit_hint("--acc-unit", ACC_UNITS, acc_unit, norm, plausible)
+        raise RecordingError(f"{rec.name}: median accelerometer norm is {norm:.3g} m/s² read as {acc_unit}, "
+                             f"far from gravity{hint}")
     if rec.quat_ref is not None:
         norm = np.linalg.norm(rec.quat_ref, axis=1)
         bad = np.isfinite(norm) & (np.abs(norm - 1.0) > UNIT_TOLERANCE)

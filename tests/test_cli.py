@@ -63,13 +63,14 @@ def test_estimate_csv_writes_the_contracted_columns_equal_to_the_batch_path(tmp_
 
 def test_estimate_without_t_column_needs_fs_and_honours_units(tmp_path, imu):
     gyr, acc = imu
-    _write_csv(tmp_path / "in.csv", _imu_columns(np.degrees(gyr), acc / 9.81, with_t=False))
-    out = tmp_path / "out.csv"
-    assert main(["estimate", str(tmp_path / "in.csv"), "--out", str(out)]) == 2
-    assert main(["estimate", str(tmp_path / "in.csv"), "--out", str(out), "--fs", "100",
-                 "--gyr-unit", "deg/s", "--acc-unit", "g", "--method", "first_order"]) == 0
     ref = estimate(gyr, acc, FS, "first_order", gyro_offset=True)
-    assert np.abs(_read_output(out)[1][:, 1:5] - ref.quat).max() < 1e-8
+    out = tmp_path / "out.csv"
+    for gyr_unit, acc_unit, scale in (("deg/s", "g", 1.0), ("mdeg/s", "mg", 1e3)):
+        _write_csv(tmp_path / "in.csv", _imu_columns(np.degrees(gyr) * scale, acc / 9.81 * scale, with_t=False))
+        assert main(["estimate", str(tmp_path / "in.csv"), "--out", str(out)]) == 2
+        assert main(["estimate", str(tmp_path / "in.csv"), "--out", str(out), "--fs", "100",
+                     "--gyr-unit", gyr_unit, "--acc-unit", acc_unit, "--method", "first_order"]) == 0
+        assert np.abs(_read_output(out)[1][:, 1:5] - ref.quat).max() < 1e-8, gyr_unit
 
 
 def test_estimate_takes_the_magnetometer_unit_and_notes_a_norm_far_from_the_earths(tmp_path, imu, capsys):
@@ -130,8 +131,12 @@ def _bad_inputs(tmp_path, gyr, acc):
     nan = {k: v.copy() for k, v in cols.items()}
     nan["gyr_y"][7] = np.nan
     cases["non-finite"] = (nan, [])
-    cases["deg/s"] = ({**cols, **{f"gyr_{a}": np.degrees(cols[f"gyr_{a}"]) * 10 for a in "xyz"}}, [])
-    cases["looks like g"] = ({**cols, **{f"acc_{a}": cols[f"acc_{a}"] / 9.81 for a in "xyz"}}, [])
+    cases["looks like deg/s: pass --gyr-unit deg/s"] = ({**cols, **{f"gyr_{a}": np.degrees(cols[f"gyr_{a}"]) * 10 for a in "xyz"}}, [])
+    cases["looks like g: pass --acc-unit g"] = ({**cols, **{f"acc_{a}": cols[f"acc_{a}"] / 9.81 for a in "xyz"}}, [])
+    cases["looks like mg: pass --acc-unit mg"] = ({**cols, **{f"acc_{a}": cols[f"acc_{a}"] * 102 for a in "xyz"}}, [])
+    mdeg = {**cols, **{f"gyr_{a}": np.degrees(cols[f"gyr_{a}"]) * 1e3 for a in "xyz"}}
+    cases["read as deg/s, beyond any MEMS gyro; looks like mdeg/s: pass --gyr-unit mdeg/s"] = (
+        mdeg, ["--gyr-unit", "deg/s"])
     jitter = dict(cols, t=cols["t"] * (1 + 0.2 * (np.arange(len(gyr)) % 2) / len(gyr)) + (np.arange(len(gyr)) % 3) * 0.004)
     cases["column t is irregular"] = (jitter, [])
     cases["unknown parameter"] = (cols, ["--param", "delta_q=1"])
