@@ -95,6 +95,8 @@ def build_parser() -> argparse.ArgumentParser:
     est.add_argument("input", help="CSV (t,gyr_x,gyr_y,gyr_z,acc_x,acc_y,acc_z[,mag_x,mag_y,mag_z]; "
                      "separated by commas, semicolons or tabs) or BROAD .mat")
     est.add_argument("--out", required=True, help="output CSV: t,q_w,q_x,q_y,q_z,g_x,g_y,g_z")
+    est.add_argument("--euler", action="store_true",
+                     help="add roll_deg,pitch_deg,yaw_deg to the output (Z-Y-X sequence of q, degrees)")
     est.add_argument("--method", default="wiener", choices=sorted(METHODS))
     est.add_argument("--param", type=_param, action="append", default=[], metavar="NAME=VALUE",
                      help="parameter of the method, the gyro-offset or the heading estimator, in the unit listed "
@@ -185,7 +187,7 @@ def cmd_estimate(args) -> int:
                       latency=args.latency, gyr_samples=args.gyr_samples)
     progress(f"estimated with {args.method}{' --offline' if args.offline else ''}")
     rows = slice(None) if rec.filled is None else ~rec.filled  # the input's rows, not those filled in
-    write_estimate(args.out, rec.t[rows], result.quat[rows], result.up[rows])
+    write_estimate(args.out, rec.t[rows], result.quat[rows], result.up[rows], euler=args.euler)
     progress(f"wrote {args.out}")
     if result.offset is not None:
         print("attitude: gyro offset estimate at the end "

@@ -8,6 +8,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from blocks.earth_filters import STANDARD_GRAVITY
 
@@ -17,6 +18,7 @@ MAG_COLUMNS = ("mag_x", "mag_y", "mag_z")
 REF_COLUMNS = ("ref_q_w", "ref_q_x", "ref_q_y", "ref_q_z")  # optional reference orientation, sensor → earth
 MOVEMENT_COLUMN = "movement"  # optional: 1 in the phase the errors are measured over, else 0
 OUTPUT_COLUMNS = ("t", "q_w", "q_x", "q_y", "q_z", "g_x", "g_y", "g_z")
+EULER_COLUMNS = ("roll_deg", "pitch_deg", "yaw_deg")  # with --euler
 GYR_UNITS = {"rad/s": 1.0, "deg/s": math.pi / 180.0, "mdeg/s": math.pi / 180e3}
 ACC_UNITS = {"m/s2": 1.0, "g": STANDARD_GRAVITY, "mg": STANDARD_GRAVITY / 1e3}
 MAG_UNITS = {"uT": 1.0, "nT": 1e-3, "G": 100.0, "mG": 0.1}  # to µT
@@ -348,7 +350,12 @@ def _check_values(rec: Recording, gyr_unit: str = "rad/s", acc_unit: str = "m/s2
                                  f"{norm[row]:.3g}; expected unit quaternions w,x,y,z (NaN where lost)")
 
 
-def write_estimate(path, t, quat, up) -> None:
-    """CSV with columns t,q_w,q_x,q_y,q_z,g_x,g_y,g_z (g the unit up-vector, sensor coordinates)."""
-    table = np.column_stack([t, quat, up])
-    np.savetxt(path, table, delimiter=",", header=",".join(OUTPUT_COLUMNS), comments="", fmt="%.10g")
+def write_estimate(path, t, quat, up, euler: bool = False) -> None:
+    """CSV with columns t,q_w,q_x,q_y,q_z,g_x,g_y,g_z (g the unit up-vector, sensor
+    coordinates); euler adds roll, pitch and yaw in degrees (EULER_COLUMNS: the Z-Y-X
+    sequence of q, as the AttitudeEstimator FMU's outputs roll, pitch, yaw)."""
+    columns, table = OUTPUT_COLUMNS, [t, quat, up]
+    if euler:
+        columns = columns + EULER_COLUMNS
+        table.append(Rotation.from_quat(quat, scalar_first=True).as_euler("ZYX", degrees=True)[:, ::-1])
+    np.savetxt(path, np.column_stack(table), delimiter=",", header=",".join(columns), comments="", fmt="%.10g")

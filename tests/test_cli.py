@@ -9,10 +9,11 @@ import pytest
 from scipy.io import savemat
 
 from blocks.methods import METHODS
+from blocks.quaternion import quat_euler_zyx
 from systems.batch import estimate
 from systems.cli import main
 from systems.motion import HumanMotion
-from systems.recording import OUTPUT_COLUMNS
+from systems.recording import EULER_COLUMNS, OUTPUT_COLUMNS
 from systems.sensor_model import ImuModel
 
 FS = 100.0
@@ -59,6 +60,23 @@ def test_estimate_csv_writes_the_contracted_columns_equal_to_the_batch_path(tmp_
     assert np.abs(data[:, 1:5] - ref.quat).max() < 1e-9
     assert np.abs(data[:, 5:8] - ref.up).max() < 1e-9
     assert np.allclose(np.linalg.norm(data[:, 5:8], axis=1), 1.0)
+
+
+def test_euler_adds_the_angles_of_the_fmus_outputs(tmp_path, imu):
+    """--euler appends roll, pitch, yaw in degrees, those the AttitudeEstimator FMU outputs
+    (blocks.quaternion.quat_euler_zyx) of the same quaternions; the other columns stay."""
+    gyr, acc = imu
+    _write_csv(tmp_path / "in.csv", _imu_columns(gyr, acc))
+    outputs = {}
+    for flags in ([], ["--euler"]):
+        assert main(["estimate", str(tmp_path / "in.csv"), "--out", str(tmp_path / "out.csv"), *flags]) == 0
+        outputs[bool(flags)] = _read_output(tmp_path / "out.csv")
+    header, data = outputs[True]
+    assert header == [*OUTPUT_COLUMNS, *EULER_COLUMNS]
+    assert np.array_equal(data[:, :len(OUTPUT_COLUMNS)], outputs[False][1])
+    fmu_angles = np.degrees([quat_euler_zyx(q / np.linalg.norm(q)) for q in data[:, 1:5]])
+    assert np.abs(data[:, len(OUTPUT_COLUMNS):] - fmu_angles).max() < 1e-6
+    assert np.ptp(data[:, -3:], axis=0).min() > 5.0  # the motion turns every angle
 
 
 def test_estimate_without_t_column_needs_fs_and_honours_units(tmp_path, imu):
