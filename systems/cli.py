@@ -157,18 +157,21 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _check_out(path) -> None:
-    """Refuse an output file whose folder does not exist, before any work is done."""
+def _check_out(path, source=None) -> None:
+    """Refuse, before any work is done, an output file whose folder does not exist or that
+    is the input file source (writing it would lose the recording)."""
     folder = Path(path).absolute().parent
     if not folder.is_dir():
         raise ValueError(f"cannot write {path}: there is no folder {folder}")
+    if source is not None and Path(path).resolve() == Path(source).resolve():
+        raise ValueError(f"cannot write {path}: it is the input; choose another --out")
 
 
 def cmd_estimate(args) -> int:
     from .batch import estimate
     from .recording import field_norm_note, read_recording, write_estimate
 
-    _check_out(args.out)
+    _check_out(args.out, args.input)
     clock = time.perf_counter()
 
     def progress(text):  # each stage takes about 3 s per million samples
@@ -230,7 +233,7 @@ def cmd_evaluate(args) -> int:
 def cmd_plot(args) -> int:
     from .plot import plot_recording
 
-    _check_out(args.out)
+    _check_out(args.out, args.file)
     result = plot_recording(args.file, args.out, args.method, dict(args.param), args.offline,
                             args.gyro_offset == "on", args.heading == "mag", _read_options(args), args.latency,
                             args.gyr_samples)

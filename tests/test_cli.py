@@ -182,6 +182,13 @@ def test_bad_input_ends_with_a_message_and_exit_2(tmp_path, imu, capsys):
         assert main([*command, "--out", str(tmp_path / "absent" / "o.csv")]) == 2
         err = capsys.readouterr().err
         assert f"there is no folder {tmp_path / 'absent'}" in err and "attitude: read" not in err, err
+    # an output that is the input (by another path) is refused, the recording kept
+    before = (tmp_path / "good.csv").read_bytes()
+    (tmp_path / "sub").mkdir()
+    for command in (["estimate", str(tmp_path / "good.csv")], ["plot", str(tmp_path / "good.csv"), "--method", "wiener"]):
+        assert main([*command, "--out", str(tmp_path / "sub" / ".." / "good.csv")]) == 2
+        assert "it is the input; choose another --out" in capsys.readouterr().err
+    assert (tmp_path / "good.csv").read_bytes() == before
 
 
 def test_console_entry_point_reports_errors_without_traceback(tmp_path):
