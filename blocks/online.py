@@ -115,6 +115,15 @@ class OnlineEstimator:
         self._Ts = None
         self.reset()
 
+    def __getstate__(self) -> dict:
+        """For copies (an FMU's saved state): everything but what the sample time derives
+        (stepper, coefficients, views of the state), which the next step makes again."""
+        derived = ("_stepper", "_heading_coef", "_offset_coef", "_views", "sensor_frame")
+        return {**{k: v for k, v in self.__dict__.items() if k not in derived}, "_Ts": None}
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+
     def reset(self) -> None:
         """Forget all samples."""
         self.state = None
@@ -152,6 +161,7 @@ class OnlineEstimator:
             self._heading_coef = heading_coefficients(self._heading_params, Ts)
             if self.gyro_offset:
                 self._offset_coef = offset_coefficients(self._offset_params, Ts)
+            self._views = None
 
         if self.point_samples and np.isfinite(self.io[0:3]).all():
             raw = self.io[0:3].copy()
@@ -172,11 +182,12 @@ class OnlineEstimator:
             self.io[0:3] -= self.offset[0]
         if starting:
             self.state = self._stepper.initial_state(start_gravity(self.io[0:3], self.io[3:6], Ts))
-            if self.sensor_frame:  # views of the state and scratch space, made once
-                n = self._stepper.disc.order
-                self._views = (self.state[: 3 * n].reshape(n, 3), self.state[3 * n:], np.empty((n, 3)))
+            self._views = None
         if self.sensor_frame:
             d = self._stepper.disc
+            if self._views is None:  # views of the state and scratch space, made once per state and Ts
+                n = d.order
+                self._views = (self.state[: 3 * n].reshape(n, 3), self.state[3 * n:], np.empty((n, 3)))
             return online_step(*self._views, self.io, d.Ad, d.Bd, d.C, d.D, d.Ts,
                                self._heading_state, self._heading_coef, self.heading, self.latency)
         if not np.isfinite(self.io[IO_INPUTS]).all():

@@ -38,6 +38,7 @@ def tuning_parameters():
 class AttitudeEstimator(ProjectSlave):
     author = "attitude-fmu"
     description = "IMU attitude estimator (Rizun's optimal Wiener filter and peers); gravity up, ENU, q sensor->earth"
+    internal_state = ("estimator", "_warned_step")
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)

@@ -20,6 +20,7 @@ from systems.sensor_model import ImuModel
 class ImuSensor(ProjectSlave):
     author = "attitude-fmu"
     description = "IMU sensor model: gyro noise density, offset, scale and misalignment, accelerometer noise and offset"
+    internal_state = ("rng", "delay", "step_size")
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)

@@ -16,6 +16,7 @@ from systems.motion import EARTH_FIELD_UT, PROFILES, profile
 class MotionProfile(ProjectSlave):
     author = "attitude-fmu"
     description = "Motion profiles with exact truth: ideal gyro, specific force, magnetic field, orientation"
+    internal_state = ("stream",)
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)

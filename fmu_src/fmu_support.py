@@ -6,6 +6,7 @@ variables onto them.
 """
 from __future__ import annotations
 
+import copy
 import hashlib
 import sys
 from pathlib import Path
@@ -36,6 +37,7 @@ UNITS = {
 
 IN, OUT, PAR = Fmi2Causality.input, Fmi2Causality.output, Fmi2Causality.parameter
 PROJECT_PACKAGES = ("blocks", "systems")  # carried in every FMU's resources
+INTERNAL_STATE = " internal"  # key of a saved FMU state's model part (no variable name has a space)
 _loaded_digests: dict[Path, str] = {}  # folder this process's project code came from → its code_digest
 
 
@@ -100,11 +102,29 @@ class UnitReal(Real):
 
 class ProjectSlave(Fmi2Slave):
     """Fmi2Slave with units and helpers; subclasses register their variables and build
-    their model from the parameters in initialise()."""
+    their model from the parameters in initialise().
+
+    fmi2GetFMUstate saves the variables and copies of the attributes named in
+    internal_state (the model's state between steps) and the error; fmi2SetFMUstate
+    restores them, as often as the master rolls back (canGetAndSetFMUstate)."""
+
+    internal_state: tuple[str, ...] = ()
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
         self.error = foreign_code(self.resources)
+
+    def _get_fmu_state(self) -> dict:
+        state = super()._get_fmu_state()
+        state[INTERNAL_STATE] = copy.deepcopy({name: getattr(self, name) for name in ("error", *self.internal_state)})
+        return state
+
+    def _set_fmu_state(self, state: dict) -> None:
+        state = dict(state)
+        internal = copy.deepcopy(state.pop(INTERNAL_STATE))  # the saved state stays as saved
+        super()._set_fmu_state(state)
+        for name, value in internal.items():
+            setattr(self, name, value)
 
     def exit_initialization_mode(self):
         if self.error is not None:

@@ -179,6 +179,55 @@ def test_reset_then_second_run_is_identical(fmu_dir, recording):
     assert np.array_equal(first, second)
 
 
+def _chain(fmu_dir, method):
+    """MotionProfile → ImuSensor (noise, offset, latency) → AttitudeEstimator (gyro offset
+    and heading estimated), stepped together: a function of the number of steps that
+    returns the estimator's outputs, and the three runners."""
+    signals = lambda *names: [f"{s}_{a}" for s in names for a in "xyz"]
+    motion = FmuRunner(fmu_dir / "MotionProfile.fmu", {"profile": "human", "seed": 3}, [],
+                       signals("omega", "f", "m"))
+    imu = FmuRunner(fmu_dir / "ImuSensor.fmu", {"delta_n": 1e-3, "acc_noise": 0.01, "gyr_offset_x": 0.01,
+                                                "latency": 0.015, "seed": 5},
+                    signals("omega", "f", "m"), signals("gyr", "acc", "mag"))
+    est = FmuRunner(fmu_dir / "AttitudeEstimator.fmu", {"method": method}, signals("gyr", "acc", "mag"),
+                    [*OUTPUTS, "gyr_offset_x", "mag_offset_z"])
+
+    def run(steps):
+        out = []
+        for _ in range(steps):
+            est_out, _ = est.step(imu.step(motion.step([], 1 / FS)[0], 1 / FS)[0], 1 / FS)
+            out.append(est_out)
+        return np.array(out)
+    return run, (motion, imu, est)
+
+
+@pytest.mark.parametrize("method", ["wiener", "tseng"])  # a kernel method and a sensor-frame one
+def test_a_master_rolls_every_fmu_back_to_a_saved_state(fmu_dir, method):
+    """canGetAndSetFMUstate: fmi2SetFMUstate takes the motion's and the sensor's random
+    generators, the sensor's delay line and the estimator's filter, offset and heading
+    states back to fmi2GetFMUstate's; stepping on gives what a run never rolled back gives,
+    from the same saved state as often as the master asks."""
+    run, runners = _chain(fmu_dir, method)
+    reference, reference_runners = _chain(fmu_dir, method)
+    run(1100)
+    saved = [(r.fmu.getFMUstate(), r.time) for r in runners]
+    tries = []
+    for _ in range(2):
+        tries.append(run(200))
+        for r, (state, time) in zip(runners, saved):
+            r.fmu.setFMUstate(state)
+            r.time = time
+    expected = reference(1300)[1100:]
+    assert np.abs(expected[:, 7]).max() > 1e-4  # the gyro offset is being estimated
+    assert np.array_equal(tries[0], expected) and np.array_equal(tries[1], expected)
+    assert np.array_equal(run(200), expected)  # a third time from the same saved state
+    assert not np.array_equal(run(200), expected)  # without a roll-back the run goes on
+    for r in (*runners, *reference_runners):
+        r.close()
+    for name in FMU_NAMES:
+        assert 'canGetAndSetFMUstate="true"' in zipfile.ZipFile(fmu_dir / f"{name}.fmu").read("modelDescription.xml").decode()
+
+
 def test_instances_in_one_process_stay_independent(fmu_dir, recording):
     gyr, acc = recording
     a, b = _estimator(fmu_dir), _estimator(fmu_dir, delta_v=3.0)
