@@ -63,8 +63,9 @@ def _add_input_flags(parser) -> None:
     parser.add_argument("--mag-unit", default="uT", choices=list(MAG_UNITS), help="magnetometer unit (default uT)")
     parser.add_argument("--t-unit", default="s", choices=list(T_UNITS), help="unit of a CSV's t column (default s)")
     parser.add_argument("--max-gap", type=float, default=MAX_GAP_S, metavar="S",
-                        help="longest run of samples missing from a CSV's time stamps that is filled in "
-                             f"(gyro and accelerometer interpolated; default {MAX_GAP_S:g} s)")
+                        help="longest run of samples missing from a CSV's time stamps, or of gyro or "
+                             "accelerometer values that are not finite, that is filled in (interpolated "
+                             f"linearly; default {MAX_GAP_S:g} s)")
     parser.add_argument("--gyr-samples", default="mean", choices=list(GYR_SAMPLES),
                         help="mean: a gyro sample is the mean rate over the sample time before it (default; the "
                              "project's convention); point: the rate at the sample's time (simulations that sample "

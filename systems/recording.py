@@ -90,7 +90,8 @@ def read_recording(path, fs: float | None = None, gyr_unit: str = "rad/s", acc_u
     replaced by fs) or a BROAD .mat, in the units given (GYR_UNITS, ACC_UNITS, MAG_UNITS,
     T_UNITS), into rad/s, m/s², µT and s. A CSV's time stamps may jitter and skip samples:
     runs of missing samples up to max_gap seconds are filled in (_fill_gaps), longer ones
-    refused."""
+    refused; so are runs of gyro or accelerometer values that are not finite
+    (_fill_non_finite)."""
     path = Path(path)
     if not path.is_file():
         raise RecordingError(f"{path}: no such file")
@@ -111,6 +112,8 @@ def read_recording(path, fs: float | None = None, gyr_unit: str = "rad/s", acc_u
         rec.notes.append(f"{rec.name}: the magnetometer has no sample (NaN throughout); heading from the gyro")
     if rec.mag is not None:
         rec.mag = rec.mag * MAG_UNITS[mag_unit]
+    _check_shapes(rec)
+    _fill_non_finite(rec, max_gap)
     _check_values(rec, gyr_unit, acc_unit)
     return rec
 
@@ -320,16 +323,44 @@ def _unit_hint(flag: str, units: dict, given: str, value: float, plausible) -> s
     return f"; looks like {fits[0]}: pass {flag} {fits[0]}" if fits else ""
 
 
-def _check_values(rec: Recording, gyr_unit: str = "rad/s", acc_unit: str = "m/s2") -> None:
+def _check_shapes(rec: Recording) -> None:
     for name in ("gyr", "acc"):
         a = getattr(rec, name)
         if a.ndim != 2 or a.shape[1] != 3 or len(a) != len(rec.gyr) or len(a) == 0:
             hint = "; stored as 3×N? transpose it" if a.ndim == 2 and a.shape[0] == 3 else ""
             raise RecordingError(f"{rec.name}: {name} must be N×3 with N ≥ 1, got {a.shape}{hint}")
-        bad = ~np.isfinite(a)
-        if bad.any():
-            row = int(np.argwhere(bad)[0][0])
-            raise RecordingError(f"{rec.name}: {name} has {int(bad.sum())} non-finite values (first in row {row + 1})")
+
+
+def _fill_non_finite(rec: Recording, max_gap: float) -> None:
+    """Gyro and accelerometer values that are not finite (a logger's dropouts) in runs of
+    rows up to max_gap seconds, between finite rows, interpolated linearly in place, and
+    noted; at the first or last row, or in a longer run, refused."""
+    bad_rows = ~(np.isfinite(rec.gyr).all(axis=1) & np.isfinite(rec.acc).all(axis=1))
+    if not bad_rows.any():
+        return
+    rows = np.flatnonzero(bad_rows)
+    starts = rows[np.concatenate([[True], np.diff(rows) > 1])]
+    ends = rows[np.concatenate([np.diff(rows) > 1, [True]])]
+    longest = int(np.argmax(ends - starts))
+    if bad_rows[0] or bad_rows[-1]:
+        edge = "first" if bad_rows[0] else "last"
+        raise RecordingError(f"{rec.name}: gyro or accelerometer values that are not finite in the {edge} row; "
+                             "cut the rows before the first or after the last finite one")
+    if (ends[longest] - starts[longest] + 1) / rec.fs > max_gap:
+        raise RecordingError(f"{rec.name}: gyro or accelerometer values that are not finite in rows "
+                             f"{starts[longest] + 1}–{ends[longest] + 1}, longer than --max-gap {max_gap:g} s; "
+                             "split the recording there or raise --max-gap")
+    index = np.arange(len(bad_rows))
+    for a in (rec.gyr, rec.acc):
+        for c in range(3):
+            good = np.isfinite(a[:, c])
+            a[~good, c] = np.interp(index[~good], index[good], a[good, c])
+    rec.notes.append(f"{rec.name}: {len(rows)} rows with gyro or accelerometer values that are not finite, in "
+                     f"{len(starts)} run{'s' * (len(starts) > 1)} (the longest "
+                     f"{(ends[longest] - starts[longest] + 1) / rec.fs:g} s), interpolated linearly")
+
+
+def _check_values(rec: Recording, gyr_unit: str = "rad/s", acc_unit: str = "m/s2") -> None:
     _check_rate(rec.name, rec.fs)
     peak = float(np.max(np.abs(rec.gyr)))
     if peak > MAX_GYRO_RAD_S:

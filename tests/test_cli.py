@@ -147,8 +147,8 @@ def _bad_inputs(tmp_path, gyr, acc):
     del missing["acc_z"]
     cases["missing columns acc_z"] = (missing, [])
     nan = {k: v.copy() for k, v in cols.items()}
-    nan["gyr_y"][7] = np.nan
-    cases["non-finite"] = (nan, [])
+    nan["gyr_y"][0] = np.nan
+    cases["values that are not finite in the first row"] = (nan, [])
     cases["looks like deg/s: pass --gyr-unit deg/s"] = ({**cols, **{f"gyr_{a}": np.degrees(cols[f"gyr_{a}"]) * 10 for a in "xyz"}}, [])
     cases["looks like g: pass --acc-unit g"] = ({**cols, **{f"acc_{a}": cols[f"acc_{a}"] / 9.81 for a in "xyz"}}, [])
     cases["looks like mg: pass --acc-unit mg"] = ({**cols, **{f"acc_{a}": cols[f"acc_{a}"] * 102 for a in "xyz"}}, [])

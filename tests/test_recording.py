@@ -194,6 +194,44 @@ def test_missing_samples_are_filled_in_and_the_output_keeps_the_input_rows(tmp_p
     assert complete < filled < 0.6 * as_uniform
 
 
+def test_rows_that_are_not_finite_are_filled_in_as_missing_samples_are(tmp_path, recording, capsys):
+    """A logger's dropouts written as NaN (or ±inf) rows, in a CSV or a .mat: interpolated as
+    the same rows missing from the time stamps are, so the estimate at the other rows is
+    theirs; the output keeps every row. Such values in the first or last row, or in a run
+    longer than --max-gap, are refused."""
+    _, gyr, acc, _ = recording
+    rng = np.random.default_rng(6)
+    keep = np.ones(len(gyr), dtype=bool)
+    for start in rng.integers(100, len(gyr) - 100, 20):
+        keep[start:start + rng.integers(1, 30)] = False
+    t = np.arange(1, len(gyr) + 1) / FS
+    _write(tmp_path / "in.csv", t[keep], gyr[keep], acc[keep])
+    missing, _ = _estimate_csv(tmp_path, capsys)
+    dropped_gyr, dropped_acc = gyr.copy(), acc.copy()
+    dropped_gyr[~keep], dropped_acc[~keep] = np.nan, np.where(np.arange(len(gyr)) % 2, np.inf, np.nan)[~keep, None]
+    _write(tmp_path / "in.csv", t, dropped_gyr, dropped_acc)
+    data, err = _estimate_csv(tmp_path, capsys)
+    runs = int((np.diff(keep.astype(int)) == -1).sum())
+    assert f"{(~keep).sum()} rows with gyro or accelerometer values that are not finite, in {runs} runs" in err, err
+    assert len(data) == len(gyr) and np.abs(data[keep] - missing).max() < 1e-9
+    savemat(tmp_path / "in.mat", {"imu_gyr": dropped_gyr, "imu_acc": dropped_acc, "sampling_rate": FS})
+    assert np.array_equal(read_recording(tmp_path / "in.mat").acc, read_recording(tmp_path / "in.csv").acc)
+    dropped_gyr[~keep] = gyr[~keep]
+    dropped_gyr[~keep, 1] = np.nan  # one column lost: the others are kept
+    _write(tmp_path / "in.csv", t, dropped_gyr, acc)
+    partial = read_recording(tmp_path / "in.csv").gyr
+    assert np.array_equal(partial[:, [0, 2]], gyr[:, [0, 2]]) and np.array_equal(partial[keep], gyr[keep])
+    for rows, flags, message in ((slice(0, 1), [], "not finite in the first row"),
+                                 (slice(-1, None), [], "not finite in the last row"),
+                                 (slice(300, 321), ["--max-gap", "0.2"], "not finite in rows 301–321, longer than "
+                                                                         "--max-gap 0.2 s")):
+        bad = gyr.copy()
+        bad[rows] = np.nan
+        _write(tmp_path / "in.csv", t, bad, acc)
+        assert main(["estimate", str(tmp_path / "in.csv"), "--out", str(tmp_path / "o.csv"), *flags]) == 2
+        assert message in capsys.readouterr().err
+
+
 def test_time_stamps_that_cannot_be_read_as_one_rate_are_refused(tmp_path, recording, capsys):
     _, gyr, acc, _ = recording
     t = np.arange(1, len(gyr) + 1) / FS
