@@ -222,6 +222,8 @@ def test_a_master_rolls_every_fmu_back_to_a_saved_state(fmu_dir, method):
     assert np.array_equal(tries[0], expected) and np.array_equal(tries[1], expected)
     assert np.array_equal(run(200), expected)  # a third time from the same saved state
     assert not np.array_equal(run(200), expected)  # without a roll-back the run goes on
+    for r, (state, _) in zip(runners, saved):
+        r.fmu.freeFMUstate(state)
     for r in (*runners, *reference_runners):
         r.close()
     for name in FMU_NAMES:
