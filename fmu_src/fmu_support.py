@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import copy
 import hashlib
+import pickle
 import sys
 from pathlib import Path
 from xml.etree.ElementTree import Element, SubElement
@@ -106,7 +107,9 @@ class ProjectSlave(Fmi2Slave):
 
     fmi2GetFMUstate saves the variables and copies of the attributes named in
     internal_state (the model's state between steps) and the error; fmi2SetFMUstate
-    restores them, as often as the master rolls back (canGetAndSetFMUstate)."""
+    restores them, as often as the master rolls back (canGetAndSetFMUstate). A saved
+    state serialises with pickle (canSerializeFMUstate): the bytes come from this FMU
+    and go back to it, and like the FMU's code they are to be trusted."""
 
     internal_state: tuple[str, ...] = ()
 
@@ -118,6 +121,14 @@ class ProjectSlave(Fmi2Slave):
         state = super()._get_fmu_state()
         state[INTERNAL_STATE] = copy.deepcopy({name: getattr(self, name) for name in ("error", *self.internal_state)})
         return state
+
+    @staticmethod
+    def _fmu_state_to_bytes(state: dict) -> bytes:
+        return pickle.dumps(state)
+
+    @staticmethod
+    def _fmu_state_from_bytes(data: bytes) -> dict:
+        return pickle.loads(data)
 
     def _set_fmu_state(self, state: dict) -> None:
         state = dict(state)

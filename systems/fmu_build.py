@@ -84,7 +84,8 @@ def build(out, names=FMU_NAMES) -> list[Path]:
         try:
             for name in names:
                 built.append(Path(FmuBuilder.build_FMU(SOURCE_DIR / f"{name}.py", dest=out, project_files=staged,
-                                                       needsExecutionTool="false", canGetAndSetFMUstate="true")))
+                                                       needsExecutionTool="false", canGetAndSetFMUstate="true",
+                                                       canSerializeFMUstate="true")))
         finally:
             sys.path.remove(str(SOURCE_DIR))
         guard = compile_guard(Path(tmp) / "fmi2_guard.so")

@@ -179,12 +179,12 @@ def test_reset_then_second_run_is_identical(fmu_dir, recording):
     assert np.array_equal(first, second)
 
 
-def _chain(fmu_dir, method):
+def _chain(fmu_dir, method, motion_profile):
     """MotionProfile → ImuSensor (noise, offset, latency) → AttitudeEstimator (gyro offset
     and heading estimated), stepped together: a function of the number of steps that
     returns the estimator's outputs, and the three runners."""
     signals = lambda *names: [f"{s}_{a}" for s in names for a in "xyz"]
-    motion = FmuRunner(fmu_dir / "MotionProfile.fmu", {"profile": "human", "seed": 3}, [],
+    motion = FmuRunner(fmu_dir / "MotionProfile.fmu", {"profile": motion_profile, "seed": 3}, [],
                        signals("omega", "f", "m"))
     imu = FmuRunner(fmu_dir / "ImuSensor.fmu", {"delta_n": 1e-3, "acc_noise": 0.01, "gyr_offset_x": 0.01,
                                                 "latency": 0.015, "seed": 5},
@@ -201,14 +201,15 @@ def _chain(fmu_dir, method):
     return run, (motion, imu, est)
 
 
-@pytest.mark.parametrize("method", ["wiener", "tseng"])  # a kernel method and a sensor-frame one
-def test_a_master_rolls_every_fmu_back_to_a_saved_state(fmu_dir, method):
+# a kernel method and a sensor-frame one; a random motion and a closed-form one
+@pytest.mark.parametrize("method, motion", [("wiener", "human"), ("tseng", "coning")])
+def test_a_master_rolls_every_fmu_back_to_a_saved_state(fmu_dir, method, motion):
     """canGetAndSetFMUstate: fmi2SetFMUstate takes the motion's and the sensor's random
     generators, the sensor's delay line and the estimator's filter, offset and heading
     states back to fmi2GetFMUstate's; stepping on gives what a run never rolled back gives,
     from the same saved state as often as the master asks."""
-    run, runners = _chain(fmu_dir, method)
-    reference, reference_runners = _chain(fmu_dir, method)
+    run, runners = _chain(fmu_dir, method, motion)
+    reference, reference_runners = _chain(fmu_dir, method, motion)
     run(1100)
     saved = [(r.fmu.getFMUstate(), r.time) for r in runners]
     tries = []
@@ -222,12 +223,17 @@ def test_a_master_rolls_every_fmu_back_to_a_saved_state(fmu_dir, method):
     assert np.array_equal(tries[0], expected) and np.array_equal(tries[1], expected)
     assert np.array_equal(run(200), expected)  # a third time from the same saved state
     assert not np.array_equal(run(200), expected)  # without a roll-back the run goes on
-    for r, (state, _) in zip(runners, saved):
+    for r, (state, time) in zip(runners, saved):  # serialised and back (canSerializeFMUstate)
+        serialised = r.fmu.serializeFMUstate(state)
         r.fmu.freeFMUstate(state)
+        r.fmu.setFMUstate(r.fmu.deSerializeFMUstate(serialised))
+        r.time = time
+    assert np.array_equal(run(200), expected)
     for r in (*runners, *reference_runners):
         r.close()
     for name in FMU_NAMES:
-        assert 'canGetAndSetFMUstate="true"' in zipfile.ZipFile(fmu_dir / f"{name}.fmu").read("modelDescription.xml").decode()
+        description = zipfile.ZipFile(fmu_dir / f"{name}.fmu").read("modelDescription.xml").decode()
+        assert 'canGetAndSetFMUstate="true"' in description and 'canSerializeFMUstate="true"' in description
 
 
 def test_instances_in_one_process_stay_independent(fmu_dir, recording):
