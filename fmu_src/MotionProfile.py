@@ -39,8 +39,8 @@ class MotionProfile(ProjectSlave):
             overrides = {p.name: getattr(self, f"{prof.name}_{p.name}") for p in prof.params}
             motion = prof.motion({k: v for k, v in overrides.items() if v != 0.0}, g=self.g)
             self.stream = motion.stream(self.seed)
-            if self.stream is motion:  # a closed-form motion: stepping it leaves no state
-                self.internal_state = ()
+            # a closed-form motion leaves no state when stepped (and pickle cannot hold its functions)
+            self.internal_state = () if self.stream is motion else ("stream",)
         except ValueError as exc:
             self.fail(f"invalid parameter: {exc}")
 
