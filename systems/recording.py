@@ -63,6 +63,8 @@ class Recording:
             raise RecordingError(f"{self.name}: no optical reference (opt_quat, or the CSV columns "
                                  f"{','.join(REF_COLUMNS)}); cannot evaluate")
         phase = np.ones(len(self.gyr), dtype=bool) if self.movement is None else self.movement
+        if not phase.any():
+            raise RecordingError(f"{self.name}: the movement flag is 0 throughout: no movement phase to measure")
         ok = phase & np.isfinite(self.quat_ref).all(axis=1)
         if not ok.any():
             raise RecordingError(f"{self.name}: the reference has no valid sample"

@@ -422,7 +422,8 @@ def test_evaluate_measures_the_imu_latency_and_carries_every_estimate_over_it(tm
     assert "latency must be a finite number of seconds" in capsys.readouterr().err
 
 
-@pytest.mark.parametrize("case", ["no optical reference", "no valid sample during movement", "not a readable"])
+@pytest.mark.parametrize("case", ["no optical reference", "no valid sample during movement", "not a readable",
+                                  "no movement phase"])
 def test_evaluate_without_reference_or_on_a_broken_file_fails_cleanly(tmp_path, capsys, case):
     motion = ClosedFormMotion("still", lambda t: Rotation.from_rotvec(np.zeros((len(t), 3))),
                               lambda t: np.zeros((len(t), 3))).generate(10.0, FS)
@@ -435,6 +436,10 @@ def test_evaluate_without_reference_or_on_a_broken_file_fails_cleanly(tmp_path, 
             data = loadmat(path)
             savemat(path, {**{k: v for k, v in data.items() if not k.startswith("__")},
                            "opt_quat": np.full_like(data["opt_quat"], np.nan)})
+        if case == "no movement phase":  # a movement flag of 0 throughout
+            data = loadmat(path)
+            savemat(path, {**{k: v for k, v in data.items() if not k.startswith("__")},
+                           "movement": np.zeros_like(data["movement"])})
     _broad_like(tmp_path / "good.mat", motion)
     assert main(["evaluate", str(tmp_path / "good.mat"), str(path)]) == 2
     err = capsys.readouterr().err
