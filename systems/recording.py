@@ -115,6 +115,7 @@ def read_recording(path, fs: float | None = None, gyr_unit: str = "rad/s", acc_u
     if rec.mag is not None:
         rec.mag = rec.mag * MAG_UNITS[mag_unit]
     _check_shapes(rec)
+    _check_rate(rec.name, rec.fs)
     _fill_non_finite(rec, max_gap)
     _check_values(rec, gyr_unit, acc_unit)
     return rec
@@ -362,8 +363,7 @@ def _fill_non_finite(rec: Recording, max_gap: float) -> None:
                      f"{(ends[longest] - starts[longest] + 1) / rec.fs:g} s), interpolated linearly")
 
 
-def _check_values(rec: Recording, gyr_unit: str = "rad/s", acc_unit: str = "m/s2") -> None:
-    _check_rate(rec.name, rec.fs)
+def _check_values(rec: Recording, gyr_unit: str, acc_unit: str) -> None:
     peak = float(np.max(np.abs(rec.gyr)))
     if peak > MAX_GYRO_RAD_S:
         hint = _unit_hint("--gyr-unit", GYR_UNITS, gyr_unit, peak, lambda p: p <= MAX_GYRO_RAD_S)
