@@ -121,9 +121,6 @@ class OnlineEstimator:
         derived = ("_stepper", "_heading_coef", "_offset_coef", "_views", "sensor_frame")
         return {**{k: v for k, v in self.__dict__.items() if k not in derived}, "_Ts": None}
 
-    def __setstate__(self, state: dict) -> None:
-        self.__dict__.update(state)
-
     def reset(self) -> None:
         """Forget all samples."""
         self.state = None

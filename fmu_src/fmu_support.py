@@ -127,10 +127,16 @@ class ProjectSlave(Fmi2Slave):
         return pickle.dumps(state)
 
     @staticmethod
-    def _fmu_state_from_bytes(data: bytes) -> dict:
-        return pickle.loads(data)
+    def _fmu_state_from_bytes(data: bytes) -> dict | None:
+        try:
+            return pickle.loads(data)
+        except Exception:  # never raise (see fail); _set_fmu_state refuses it
+            return None
 
-    def _set_fmu_state(self, state: dict) -> None:
+    def _set_fmu_state(self, state: dict | None) -> None:
+        if not (isinstance(state, dict) and INTERNAL_STATE in state):
+            self.log("fmi2SetFMUstate: not a state this FMU saved or serialised; state unchanged", Fmi2Status.error)
+            return
         state = dict(state)
         internal = copy.deepcopy(state.pop(INTERNAL_STATE))  # the saved state stays as saved
         super()._set_fmu_state(state)

@@ -229,6 +229,9 @@ def test_a_master_rolls_every_fmu_back_to_a_saved_state(fmu_dir, method, motion)
         r.fmu.setFMUstate(r.fmu.deSerializeFMUstate(serialised))
         r.time = time
     assert np.array_equal(run(200), expected)
+    with pytest.raises(FMICallException):  # bytes it did not write: fmi2Error, the state kept
+        runners[2].fmu.setFMUstate(runners[2].fmu.deSerializeFMUstate(b"not a saved state"))
+    assert np.array_equal(run(100), reference(100))
     for r in (*runners, *reference_runners):
         r.close()
     for name in FMU_NAMES:
