@@ -1,7 +1,9 @@
 """ImuSensor.fmu: ideal motion signals in, measured IMU signals out (systems.sensor_model.ImuModel).
 
 Noise is drawn per step from numpy's generator seeded with `seed`, in the order the
-batch path draws it, so a run equals ImuModel.apply on the same samples. With a
+batch path draws it, so a run equals ImuModel.apply on the same samples; the
+magnetometer's from a stream of its own (mag_noise_generator), as ImuModel.apply_mag
+draws it. With a
 `latency`, the measured signals are those of the motion that long ago (ImuModel's delay
 line; before the first step, the motion of the first step), which needs a fixed step.
 """
@@ -14,13 +16,14 @@ from fmu_support import IN, OUT, PAR, Integer, ProjectSlave
 
 from blocks.online import same_step
 from systems.motion import EARTH_FIELD_UT
-from systems.sensor_model import ImuModel
+from systems.sensor_model import ImuModel, mag_noise_generator
 
 
 class ImuSensor(ProjectSlave):
     author = "attitude-fmu"
-    description = "IMU sensor model: gyro noise density, offset, scale and misalignment, accelerometer noise and offset"
-    internal_state = ("rng", "delay", "step_size")
+    description = ("IMU sensor model: gyro noise density, offset, scale and misalignment, accelerometer noise and "
+                   "offset, magnetometer noise and hard iron")
+    internal_state = ("rng", "mag_rng", "delay", "step_size")
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
@@ -29,7 +32,7 @@ class ImuSensor(ProjectSlave):
         self.vector("m", EARTH_FIELD_UT, "uT", "true magnetic field {c}", IN)
         self.vector("gyr", (0.0, 0.0, 0.0), "rad/s", "measured angular rate {c}", OUT)
         self.vector("acc", (0.0, 0.0, 9.81), "m/s2", "measured specific force {c}", OUT)
-        self.vector("mag", EARTH_FIELD_UT, "uT", "measured magnetic field {c} (ideal)", OUT)
+        self.vector("mag", EARTH_FIELD_UT, "uT", "measured magnetic field {c}", OUT)
         self.real("delta_n", 0.0, "rad/s/sqrt(Hz)", "gyro white-noise density, one-sided", PAR)
         self.vector("gyr_offset", (0.0, 0.0, 0.0), "rad/s", "constant gyro offset {c}", PAR)
         for row in "xyz":
@@ -38,6 +41,8 @@ class ImuSensor(ProjectSlave):
         self.real("acc_noise", 0.0, "m/s2/sqrt(Hz)", "accelerometer white-noise density, one-sided", PAR)
         self.vector("acc_offset", (0.0, 0.0, 0.0), "m/s2", "constant accelerometer offset {c}", PAR)
         self.real("latency", 0.0, "s", "how long gyr and acc lag the motion (a fixed step needed)", PAR)
+        self.real("mag_noise", 0.0, "uT/sqrt(Hz)", "magnetometer white-noise density, one-sided", PAR)
+        self.vector("mag_offset", (0.0, 0.0, 0.0), "uT", "hard iron: a field {c} fixed to the sensor", PAR)
         self.parameter("seed", 1, "seed of the noise generator", Integer)
         self.model = None
 
@@ -48,9 +53,10 @@ class ImuSensor(ProjectSlave):
                 gyr_offset=(self.gyr_offset_x, self.gyr_offset_y, self.gyr_offset_z),
                 gyr_scale=tuple(tuple(getattr(self, f"gyr_scale_{row}_{c}") for c in "xyz") for row in "xyz"),
                 acc_offset=(self.acc_offset_x, self.acc_offset_y, self.acc_offset_z),
-                latency=self.latency,
+                latency=self.latency, mag_noise=self.mag_noise,
+                mag_offset=(self.mag_offset_x, self.mag_offset_y, self.mag_offset_z),
             )
-            self.rng = np.random.default_rng(self.seed)
+            self.rng, self.mag_rng = np.random.default_rng(self.seed), mag_noise_generator(self.seed)
             self.delay, self.step_size = None, None
         except ValueError as exc:
             self.fail(f"invalid parameter: {exc}")
@@ -70,5 +76,6 @@ class ImuSensor(ProjectSlave):
         gyr, acc = self.model.measure(signals[0:3], signals[3:6], self.rng.standard_normal(6), 1.0 / step_size)
         self.gyr_x, self.gyr_y, self.gyr_z = (float(v) for v in gyr)
         self.acc_x, self.acc_y, self.acc_z = (float(v) for v in acc)
-        self.mag_x, self.mag_y, self.mag_z = self.m_x, self.m_y, self.m_z
+        mag = self.model.measure_mag((self.m_x, self.m_y, self.m_z), self.mag_rng.standard_normal(3), 1.0 / step_size)
+        self.mag_x, self.mag_y, self.mag_z = (float(v) for v in mag)
         return True

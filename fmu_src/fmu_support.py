@@ -32,6 +32,7 @@ UNITS = {
     "m/s2/sqrt(Hz)": None,
     "m/s2": {"m": 1, "s": -2},
     "uT": {"kg": 1, "s": -2, "A": -1, "factor": 1e-6},
+    "uT/sqrt(Hz)": None,
     "1": {},
 }
 

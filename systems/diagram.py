@@ -19,6 +19,7 @@ from .motion import AXES, EARTH_FIELD_UT, HumanMotion
 from .sensor_model import ImuModel
 
 NOISE_INPUTS = [f"eps_{s}_{a}" for s in "vw" for a in AXES] + [f"{s}_{a}" for s in ("n", "na") for a in AXES]
+MAG_NOISE_INPUTS = [f"nm_{a}" for a in AXES]  # the magnetometer's, with the heading stage
 
 
 def attitude_error_system(fs: float, name: str = "error"):
@@ -34,13 +35,14 @@ def attitude_error_system(fs: float, name: str = "error"):
                          outputs=["incl_err"], dt=1.0 / fs, name=name)
 
 
-def magnetometer_system(fs: float, name: str = "magnetometer"):
-    """Static block: the ideal field mag_* (µT, sensor coordinates) at the orientation qt_*
+def magnetometer_system(imu: ImuModel, fs: float, name: str = "magnetometer"):
+    """Static block: the field mag_* (µT, sensor coordinates) the magnetometer of imu
+    measures (ImuModel.measure_mag, unit-normal noise nm_*) at the orientation qt_*
     (EARTH_FIELD_UT in the earth frame, as systems.motion.Motion.mag)."""
     def output(t, x, u, params):
-        return np.array(quat_rotate((u[0], -u[1], -u[2], -u[3]), EARTH_FIELD_UT))
+        return imu.measure_mag(quat_rotate((u[0], -u[1], -u[2], -u[3]), EARTH_FIELD_UT), u[4:7], fs)
 
-    return control.nlsys(None, output, inputs=["qt_w", "qt_x", "qt_y", "qt_z"],
+    return control.nlsys(None, output, inputs=["qt_w", "qt_x", "qt_y", "qt_z", *MAG_NOISE_INPUTS],
                          outputs=[f"mag_{a}" for a in AXES], dt=1.0 / fs, name=name)
 
 
@@ -52,7 +54,7 @@ def closed_loop(motion: HumanMotion, imu: ImuModel, fs: float, method: str = "wi
     offset: the gyro-offset estimator (blocks.gyro_offset, its low-passes at rest on g·ẑ)
     between sensor and estimator; heading: the heading stage (blocks.heading) on the
     estimator's orientation and the magnetometer. Inputs: NOISE_INPUTS (unit-normal
-    samples); outputs: incl_err (rad), ghat_*, q_*, with offset the gyro offset estimate
+    samples; with heading also MAG_NOISE_INPUTS); outputs: incl_err (rad), ghat_*, q_*, with offset the gyro offset estimate
     offset_* (rad/s), with heading qh_* and the hard-iron estimate mag_offset_* (µT);
     latency (s, non-zero): the latency stage (blocks.timing) on the last orientation and
     ghat_*, outputs ql_* and ghatl_*.
@@ -72,23 +74,24 @@ def closed_loop(motion: HumanMotion, imu: ImuModel, fs: float, method: str = "wi
     states.append(stepper(method, tuple(sorted(params.items())), dt).initial_state([0.0, 0.0, motion.g]))
     outputs = ["incl_err"] + GRAVITY_OUTPUTS + QUAT_NAMES + ([f"offset_{a}" for a in AXES] if offset else [])
     if heading:
-        estimator += [magnetometer_system(fs), heading_system(dt, heading_params)]
+        estimator += [magnetometer_system(imu, fs), heading_system(dt, heading_params)]
         states.append(heading_initial_state())
         outputs += [f"qh_{c}" for c in "wxyz"] + [f"mag_offset_{a}" for a in AXES]
     if latency:
         estimator.append(latency_system(dt, latency, [f"q{'h' if heading else ''}_{c}" for c in "wxyz"]))
         outputs += [f"ql_{c}" for c in "wxyz"] + [f"ghatl_{a}" for a in AXES]
     diagram = control.interconnect([motion.system(fs), sensor, *estimator, attitude_error_system(fs)],
-                                   inplist=NOISE_INPUTS, outlist=outputs, outputs=outputs, name="closed_loop")
+                                   inplist=NOISE_INPUTS + (MAG_NOISE_INPUTS if heading else []), outlist=outputs,
+                                   outputs=outputs, name="closed_loop")
     return diagram, np.concatenate(states)
 
 
 def simulate_closed_loop(motion: HumanMotion, imu: ImuModel, fs: float, duration: float,
                          method: str = "wiener", params: dict | None = None, seed: int = 0,
                          offset: bool = False, heading: bool = False, latency: float = 0.0):
-    """Short run of the diagram (see closed_loop) with fixed-seed noise: (noise N×12, response)."""
+    """Short run of the diagram (see closed_loop) with fixed-seed noise: (noise N×12, N×15 with heading; response)."""
     diagram, x0 = closed_loop(motion, imu, fs, method, params, offset, heading, latency)
     n = int(round(duration * fs))
-    noise = np.random.default_rng(seed).standard_normal((n, len(NOISE_INPUTS)))
+    noise = np.random.default_rng(seed).standard_normal((n, diagram.ninputs))
     t = np.arange(n) / fs
     return noise, control.input_output_response(diagram, t, noise.T, X0=x0)

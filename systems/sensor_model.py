@@ -10,9 +10,16 @@ import numpy as np
 from .motion import AXES, Motion
 
 
+def mag_noise_generator(seed: int) -> np.random.Generator:
+    """The magnetometer's noise stream for seed: one of its own, so that the gyro's and the
+    accelerometer's noise (default_rng(seed)) do not depend on the magnetometer's settings."""
+    return np.random.default_rng((seed, 1))
+
+
 @dataclass(frozen=True)
 class ImuModel:
-    """Gyro y_g = (I + S)·ω + n + b, accelerometer y_a = f + n_a + acc_offset, magnetometer ideal.
+    """Gyro y_g = (I + S)·ω + n + b, accelerometer y_a = f + n_a + acc_offset, magnetometer
+    y_m = m + n_m + mag_offset.
 
     delta_n: gyro white-noise density, rad/s/√Hz (one-sided; per-sample s.d.
     delta_n·√(fs/2)); gyr_offset: constant gyro offset b, rad/s (3); gyr_scale: the gyro's
@@ -20,8 +27,10 @@ class ImuModel:
     rate component; 1 = 100 %); acc_noise:
     accelerometer white-noise density, m/s²/√Hz; acc_offset: constant accelerometer
     offset, m/s² (3); latency: how long the measured gyro and accelerometer lag the motion,
-    s (see delay_step; blocks.timing compensates it). Noise enters as unit-normal
-    samples, 6 per sample (gyro, acc).
+    s (see delay_step; blocks.timing compensates it); mag_noise: magnetometer white-noise
+    density, µT/√Hz; mag_offset: hard iron, a field fixed to the sensor, µT (3; the
+    magnetometer has no latency). Noise enters as unit-normal samples, 6 per sample (gyro,
+    acc), and 3 for the magnetometer (measure_mag).
     """
 
     delta_n: float = 0.0
@@ -30,13 +39,15 @@ class ImuModel:
     acc_noise: float = 0.0
     acc_offset: tuple = (0.0, 0.0, 0.0)
     latency: float = 0.0
+    mag_noise: float = 0.0
+    mag_offset: tuple = (0.0, 0.0, 0.0)
 
     def __post_init__(self):
-        for name in ("delta_n", "acc_noise", "latency"):
+        for name in ("delta_n", "acc_noise", "latency", "mag_noise"):
             value = getattr(self, name)
             if not (math.isfinite(value) and value >= 0):
                 raise ValueError(f"{name} must be finite and non-negative, got {value!r}")
-        for name in ("gyr_offset", "acc_offset"):
+        for name in ("gyr_offset", "acc_offset", "mag_offset"):
             v = np.asarray(getattr(self, name), dtype=float)
             if v.shape != (3,) or not np.isfinite(v).all():
                 raise ValueError(f"{name} must be 3 finite numbers, got {getattr(self, name)!r}")
@@ -54,6 +65,12 @@ class ImuModel:
                + np.asarray(self.gyr_offset))
         acc = np.asarray(f) + self.acc_noise * scale * noise[..., 3:6] + np.asarray(self.acc_offset)
         return gyr, acc
+
+    def measure_mag(self, m, noise, fs: float) -> np.ndarray:
+        """Measured field (…×3, µT) from the true field m (…×3, µT, sensor coordinates) and
+        unit-normal noise (…×3) at sample rate fs (Hz)."""
+        return (np.asarray(m) + self.mag_noise * math.sqrt(fs / 2.0) * np.asarray(noise)
+                + np.asarray(self.mag_offset))
 
     def delay_state(self, fs: float, first) -> np.ndarray:
         """The delay line's state at sample rate fs (Hz) before the first sample: the past
@@ -84,6 +101,10 @@ class ImuModel:
         latency, of the motion that long ago: delayed)."""
         noise = np.random.default_rng(seed).standard_normal((len(motion.gyr), 6))
         return self.measure(*self.delayed(motion.gyr, motion.acc, motion.fs), noise, motion.fs)
+
+    def apply_mag(self, motion: Motion, seed: int = 1) -> np.ndarray:
+        """Measured field (N×3, µT) of a motion, noise from mag_noise_generator(seed)."""
+        return self.measure_mag(motion.mag, mag_noise_generator(seed).standard_normal((len(motion.gyr), 3)), motion.fs)
 
     def system(self, fs: float, name: str = "imu"):
         """Discrete python-control system: inputs omega_*, f_*, n_*, na_* (unit normal);

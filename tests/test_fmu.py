@@ -352,6 +352,7 @@ def test_an_fmu_of_other_code_than_the_process_has_loaded_ends_initialisation_in
     ("ImuSensor", {"delta_n": -1.0}, "delta_n"),
     ("ImuSensor", {"seed": -3}, "negative"),
     ("ImuSensor", {"latency": -0.01}, "latency must be finite and non-negative"),
+    ("ImuSensor", {"mag_noise": -0.1}, "mag_noise must be finite and non-negative"),
     ("MotionProfile", {"profile": "jogging"}, "jogging"),
     ("MotionProfile", {"seed": -3}, "negative"),
 ])
@@ -461,6 +462,31 @@ def test_a_late_sensor_fmu_and_the_estimator_fmus_latency_under_the_master_equal
     print(f"tilt RMS: sensor 15 ms late {math.degrees(errors[0.0]):.3f}°, carried forward "
           f"{math.degrees(errors[latency]):.3f}°, sensor without delay {math.degrees(prompt):.3f}°")
     assert errors[latency] == pytest.approx(prompt, rel=0.05) and errors[0.0] > 1.5 * prompt
+
+
+def test_a_sensor_fmus_hard_iron_is_found_by_the_estimator_fmu_under_the_master(fmu_dir, tmp_path):
+    """ImuSensor.fmu with magnetometer noise and hard iron measures ImuModel.apply_mag's
+    field; the estimator FMU downstream (defaults: heading from the magnetometer, hard-iron
+    fit) gives the batch path's orientation and hard-iron estimate, which comes within
+    0.3 µT of the sensor's."""
+    dn, hard_iron, duration = math.radians(0.1), (15.0, -10.0, 5.0), 60.0
+    ssp = write_ssp(tmp_path / "iron.ssp", fmu_dir, {
+        "motion": {"profile": "human", "seed": 3},
+        "imu": {"delta_n": dn, "seed": 4, "mag_noise": 0.2, **{f"mag_offset_{c}": v for c, v in zip("xyz", hard_iron)}},
+        "estimator": {}}, duration, 1 / FS)
+    out = cosimulate(ssp, duration, 1 / FS)
+    motion = profile("human").motion().generate(duration, FS, 3)
+    imu = ImuModel(delta_n=dn, mag_noise=0.2, mag_offset=hard_iron)
+    gyr, acc = imu.apply(motion, 4)
+    mag = imu.apply_mag(motion, 4)
+    assert np.abs(np.column_stack([out[f"imu.mag_{c}"] for c in "xyz"]) - mag).max() < 1e-12
+    ref = estimate(gyr, acc, FS, mag=mag, gyro_offset=True)
+    assert np.abs(np.column_stack([out[f"estimator.q_{c}"] for c in "wxyz"]) - ref.quat).max() < 1e-9
+    found = np.column_stack([out[f"estimator.mag_offset_{c}"] for c in "xyz"])
+    assert np.abs(found - ref.mag_offset).max() < 1e-9
+    taken = int(np.argmax(np.abs(found).sum(axis=1) > 0))
+    print(f"\nhard iron {hard_iron} µT taken at {taken / FS:.1f} s as {np.round(found[-1], 2)} µT")
+    assert taken > 0 and np.abs(found[-1] - hard_iron).max() < 0.3, found[-1]
 
 
 def test_fmpy_simulate_ssp_runs_the_same_diagram_one_step_per_connection_later(fmu_dir, tmp_path):

@@ -88,16 +88,21 @@ def test_closed_loop_diagram_equals_the_batch_pipeline(method):
     assert np.abs(resp.outputs[0] - inclination_error(est.gravity, up)).max() <= 1e-12
 
 
-@pytest.mark.parametrize("params, latency", [({}, 0.0), ({"delta_n": math.radians(0.3), "rest_time": 1.0,
-                                                            "tau_heading": 2.0}, 0.015)])
-def test_closed_loop_diagram_with_offset_and_heading_blocks_equals_the_batch_kernels(params, latency):
-    """motion → sensor → gyro-offset estimator → wiener → heading stage (fed by an ideal
-    magnetometer) → latency stage as python-control blocks: the same numbers as the batch
-    path's kernels run over the sensor's samples (the offset estimator's low-passes at rest
-    on g·ẑ, as the diagram starts it), with the defaults and with parameters of every
-    stage; with a latency, the sensor's delay line (at rest, level before the start) as well."""
+@pytest.mark.parametrize("params, latency, mag_errors", [
+    ({}, 0.0, {}),
+    ({"delta_n": math.radians(0.3), "rest_time": 1.0, "tau_heading": 2.0}, 0.015,
+     {"mag_noise": 0.5, "mag_offset": (8.0, -3.0, 12.0)}),
+])
+def test_closed_loop_diagram_with_offset_and_heading_blocks_equals_the_batch_kernels(params, latency, mag_errors):
+    """motion → sensor → gyro-offset estimator → wiener → heading stage (fed by the
+    magnetometer block, ideal or with noise and hard iron) → latency stage as
+    python-control blocks: the same numbers as the batch path's kernels run over the
+    sensor's samples (the offset estimator's low-passes at rest on g·ẑ, as the diagram
+    starts it), with the defaults and with parameters of every stage; with a latency, the
+    sensor's delay line (at rest, level before the start) as well."""
     motion = HumanMotion()
-    imu = ImuModel(delta_n=math.radians(0.1), gyr_offset=(0.01, 0.0, -0.01), acc_noise=0.01, latency=latency)
+    imu = ImuModel(delta_n=math.radians(0.1), gyr_offset=(0.01, 0.0, -0.01), acc_noise=0.01, latency=latency,
+                   **mag_errors)
     fs = 100.0
     noise, resp = simulate_closed_loop(motion, imu, fs, duration=5.0, params=params, seed=3, offset=True, heading=True,
                                        latency=latency)
@@ -114,7 +119,8 @@ def test_closed_loop_diagram_with_offset_and_heading_blocks_equals_the_batch_ker
     gyro_offset.run(gyro_offset.initial_state(coef, np.zeros(3), np.array([0.0, 0.0, motion.g])), coef,
                     gyr, np.ascontiguousarray(acc), offset, variance)
     est = estimate(gyr - offset, acc, fs, params=noise_density, initial_gravity=[0, 0, motion.g])
-    mag = Rotation.from_quat(truth[:, 6:10], scalar_first=True).inv().apply(EARTH_FIELD_UT)
+    mag = imu.measure_mag(Rotation.from_quat(truth[:, 6:10], scalar_first=True).inv().apply(EARTH_FIELD_UT),
+                          noise[:, 12:15], fs)
     quat, _, mag_offset = with_magnetometer(est.quat, mag, fs, heading_params)
     out = dict(zip(resp.output_labels, resp.outputs))
     assert np.abs(np.column_stack([out[f"ghat_{c}"] for c in "xyz"]) - est.gravity).max() <= 1e-12
