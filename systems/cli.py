@@ -117,7 +117,8 @@ def build_parser() -> argparse.ArgumentParser:
     _add_input_flags(ev)
     _add_real_data_flags(ev)
 
-    pl = sub.add_parser("plot", help="a recording's error over time and its spectrum against eq. 42 (PNG)")
+    pl = sub.add_parser("plot", help="a recording's error over time and its spectrum against eq. 42 (PNG); "
+                        "without a reference, the estimate's angles over time")
     pl.add_argument("file", metavar="FILE")
     pl.add_argument("--method", default="wiener", choices=sorted(METHODS))
     pl.add_argument("--out", required=True, help="PNG to write")
@@ -238,6 +239,10 @@ def cmd_plot(args) -> int:
     result = plot_recording(args.file, args.out, args.method, dict(args.param), args.offline,
                             args.gyro_offset == "on", args.heading == "mag", _read_options(args), args.latency,
                             args.gyr_samples)
+    if not result:
+        print(f"attitude: wrote {args.out} (no reference to measure errors against: the estimate's roll, pitch "
+              "and yaw over time)", file=sys.stderr)
+        return 0
     heading = f", heading RMSE {result['heading_rmse_deg']:.2f}°" if "heading_rmse_deg" in result else ""
     print(f"attitude: wrote {args.out} (inclination RMSE {result['inclination_rmse_deg']:.2f}°{heading})",
           file=sys.stderr)

@@ -1,4 +1,5 @@
-"""`attitude plot`: a recording's inclination error over time and its spectrum against eq. 42."""
+"""`attitude plot`: a recording's inclination error over time and its spectrum against eq. 42;
+without a reference, the estimate's angles over time."""
 from __future__ import annotations
 
 import math
@@ -13,7 +14,7 @@ from blocks.stages import split_params
 
 from .batch import estimate
 from .errors import quaternion_errors
-from .recording import RecordingError, read_recording
+from .recording import RecordingError, euler_degrees, read_recording
 
 
 def plot_recording(path, out, method: str = "wiener", params=None, offline: bool = False,
@@ -24,20 +25,27 @@ def plot_recording(path, out, method: str = "wiener", params=None, offline: bool
     heading error with the samples the disturbance guard refused shaded and the times a
     hard-iron offset was taken or dropped marked, and the tilt error's spectrum beside eq. 42.
     Returns the inclination and (with the magnetometer) heading RMSE (deg) over the
-    movement phase (Recording.evaluated). read_options: keyword arguments of read_recording;
-    latency (s) and gyr_samples: as systems.batch.estimate's."""
+    movement phase (Recording.evaluated). A recording without a reference gets the
+    estimate's roll, pitch and yaw over time instead (and the gyro offset estimate), and
+    an empty dict. read_options: keyword arguments of read_recording; latency (s) and
+    gyr_samples: as systems.batch.estimate's."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     rec = read_recording(path, **(read_options or {}))
-    valid = rec.evaluated()
-    if valid.sum() < 16:
+    valid = None if rec.quat_ref is None else rec.evaluated()
+    if valid is not None and valid.sum() < 16:
         raise RecordingError(f"{rec.name}: too few valid reference samples to plot")
     mag = rec.mag if heading else None
     est = estimate(rec.gyr, rec.acc, rec.fs, method, params, offline=offline, gyro_offset=gyro_offset, mag=mag,
                    latency=latency, gyr_samples=gyr_samples)
+    label = f"{method}{' --offline' if offline else ''}{f' --latency {latency:g}' if latency else ''}"
+    t = np.arange(1, len(rec.gyr) + 1) / rec.fs
+    if valid is None:
+        _plot_angles(plt, rec.name, label, t, est, out)
+        return {}
     inclination, heading_error = np.full(len(rec.gyr), np.nan), np.full(len(rec.gyr), np.nan)
     _, heading_error[valid], inclination[valid] = np.degrees(quaternion_errors(est.quat[valid], rec.quat_ref[valid]))
     # horizontal earth-frame components of the estimated up: small-angle tilt errors, rad
@@ -46,12 +54,10 @@ def plot_recording(path, out, method: str = "wiener", params=None, offline: bool
     f, psd = signal.welch(tilt, fs=rec.fs, nperseg=min(len(tilt), int(60 * rec.fs)), axis=0)
     fig, axes = plt.subplots(2 if mag is None else 3, 1, figsize=(8, 7 if mag is None else 10))
     top, bottom = axes[0], axes[-1]
-    t = np.arange(1, len(rec.gyr) + 1) / rec.fs
     top.plot(t, inclination, lw=0.7)
     top.set_xlabel("time, s")
     top.set_ylabel("inclination error, °")
     rmse = {"inclination_rmse_deg": math.sqrt(float(np.nanmean(inclination**2)))}
-    label = f"{method}{' --offline' if offline else ''}{f' --latency {latency:g}' if latency else ''}"
     top.set_title(f"{rec.name}: {label}\nRMSE {rmse['inclination_rmse_deg']:.2f}° over the movement phase")
     if mag is not None:
         rmse["heading_rmse_deg"] = math.sqrt(float(np.nanmean(heading_error**2)))
@@ -74,6 +80,40 @@ def plot_recording(path, out, method: str = "wiener", params=None, offline: bool
     fig.savefig(out, dpi=110)
     plt.close(fig)
     return rmse
+
+
+def _plot_angles(plt, name, label, t, est, out) -> None:
+    """The estimate's roll and pitch, its yaw (shaded where the magnetometer's field was
+    refused) and, when estimated, the gyro offset, over time, into out (PNG)."""
+    panels = 2 + (est.offset is not None)
+    fig, axes = plt.subplots(panels, 1, figsize=(8, 3.2 * panels), sharex=True)
+    angles = euler_degrees(est.quat)
+    angles[1:][np.abs(np.diff(angles, axis=0)) > 180.0] = np.nan  # no line across a wrap at ±180°
+    for i, name_i in enumerate(("roll", "pitch")):
+        axes[0].plot(t, angles[:, i], lw=0.7, label=name_i)
+    axes[0].set_ylabel("°")
+    axes[0].set_title(f"{name}: {label} (no reference: the estimate)")
+    axes[1].plot(t, angles[:, 2], lw=0.7, color="C2", label="yaw")
+    axes[1].set_ylabel("°")
+    if est.mag_accepted is not None:
+        refused = ~est.mag_accepted
+        axes[1].fill_between(t, 0, 1, where=refused, transform=axes[1].get_xaxis_transform(), color="0.85",
+                             step="mid", label=f"field refused ({100 * refused.mean():.0f} % of samples)")
+        axes[1].set_title("yaw, from the magnetometer")
+    else:
+        axes[1].set_title("yaw, from the gyro (6D)")
+    if est.offset is not None:
+        for i, axis in enumerate("xyz"):
+            axes[2].plot(t, np.degrees(est.offset[:, i]), lw=0.9, label=axis)
+        axes[2].set_ylabel("°/s")
+        axes[2].set_title("gyro offset estimate")
+    axes[-1].set_xlabel("time, s")
+    for ax in axes:
+        ax.grid(True, alpha=0.3)
+        ax.legend(loc="upper right")
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
+    plt.close(fig)
 
 
 def _heading_panel(ax, t, heading_error, est, rmse) -> None:

@@ -383,12 +383,17 @@ def _check_values(rec: Recording, gyr_unit: str, acc_unit: str) -> None:
                                  f"{norm[row]:.3g}; expected unit quaternions w,x,y,z (NaN where lost)")
 
 
+def euler_degrees(quat) -> np.ndarray:
+    """Roll, pitch, yaw (N×3, degrees) of quaternions (N×4, w first, sensor → earth): the
+    Z-Y-X sequence, as the AttitudeEstimator FMU's outputs roll, pitch, yaw."""
+    return Rotation.from_quat(quat, scalar_first=True).as_euler("ZYX", degrees=True)[:, ::-1]
+
+
 def write_estimate(path, t, quat, up, euler: bool = False) -> None:
     """CSV with columns t,q_w,q_x,q_y,q_z,g_x,g_y,g_z (g the unit up-vector, sensor
-    coordinates); euler adds roll, pitch and yaw in degrees (EULER_COLUMNS: the Z-Y-X
-    sequence of q, as the AttitudeEstimator FMU's outputs roll, pitch, yaw)."""
+    coordinates); euler adds roll, pitch and yaw in degrees (EULER_COLUMNS, euler_degrees)."""
     columns, table = OUTPUT_COLUMNS, [t, quat, up]
     if euler:
         columns = columns + EULER_COLUMNS
-        table.append(Rotation.from_quat(quat, scalar_first=True).as_euler("ZYX", degrees=True)[:, ::-1])
+        table.append(euler_degrees(quat))
     np.savetxt(path, np.column_stack(table), delimiter=",", header=",".join(columns), comments="", fmt="%.10g")

@@ -657,7 +657,7 @@ def test_heading_and_tilt_start_in_motion():
     assert rms(inclination[settled:]) < 1.0
 
 
-def test_plot_writes_a_png_and_refuses_a_recording_without_reference(tmp_path, capsys):
+def test_plot_writes_the_errors_or_without_a_reference_the_estimates_angles(tmp_path, capsys):
     motion = ClosedFormMotion("turns", lambda t: Rotation.from_euler("ZY", np.column_stack([
         0.8 * np.sin(0.5 * t), 0.5 * np.sin(0.3 * t)])), lambda t: np.zeros((len(t), 3))).generate(60.0, FS)
     _broad_like(tmp_path / "a.mat", motion)
@@ -672,5 +672,8 @@ def test_plot_writes_a_png_and_refuses_a_recording_without_reference(tmp_path, c
     assert main(["plot", str(tmp_path / "a.mat"), "--out", str(out), "--heading", "gyro"]) == 0
     assert "heading RMSE" not in capsys.readouterr().err
     _broad_like(tmp_path / "b.mat", motion, quat_ref=False)
-    assert main(["plot", str(tmp_path / "b.mat"), "--out", str(tmp_path / "b.png")]) == 2
-    assert "no optical reference" in capsys.readouterr().err
+    for flags in ([], ["--heading", "gyro", "--gyro-offset", "off"]):  # three panels, two
+        (tmp_path / "b.png").unlink(missing_ok=True)
+        assert main(["plot", str(tmp_path / "b.mat"), "--out", str(tmp_path / "b.png"), *flags]) == 0
+        assert "no reference to measure errors against: the estimate's roll, pitch and yaw" in capsys.readouterr().err
+        assert (tmp_path / "b.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
