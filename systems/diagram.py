@@ -54,8 +54,9 @@ def closed_loop(motion: HumanMotion, imu: ImuModel, fs: float, method: str = "wi
     offset: the gyro-offset estimator (blocks.gyro_offset, its low-passes at rest on g·ẑ)
     between sensor and estimator; heading: the heading stage (blocks.heading) on the
     estimator's orientation and the magnetometer. Inputs: NOISE_INPUTS (unit-normal
-    samples; with heading also MAG_NOISE_INPUTS); outputs: incl_err (rad), ghat_*, q_*, with offset the gyro offset estimate
-    offset_* (rad/s), with heading qh_* and the hard-iron estimate mag_offset_* (µT);
+    samples; with heading also MAG_NOISE_INPUTS); outputs: incl_err (rad), ghat_*, q_*,
+    with offset the gyro offset estimate offset_* (rad/s), with heading qh_* and the
+    hard-iron estimate mag_offset_* (µT);
     latency (s, non-zero): the latency stage (blocks.timing) on the last orientation and
     ghat_*, outputs ql_* and ghatl_*.
     """
@@ -89,7 +90,8 @@ def closed_loop(motion: HumanMotion, imu: ImuModel, fs: float, method: str = "wi
 def simulate_closed_loop(motion: HumanMotion, imu: ImuModel, fs: float, duration: float,
                          method: str = "wiener", params: dict | None = None, seed: int = 0,
                          offset: bool = False, heading: bool = False, latency: float = 0.0):
-    """Short run of the diagram (see closed_loop) with fixed-seed noise: (noise N×12, N×15 with heading; response)."""
+    """Short run of the diagram (see closed_loop) with fixed-seed noise: (noise N×12, or
+    N×15 with heading; response)."""
     diagram, x0 = closed_loop(motion, imu, fs, method, params, offset, heading, latency)
     n = int(round(duration * fs))
     noise = np.random.default_rng(seed).standard_normal((n, diagram.ninputs))

@@ -96,9 +96,7 @@ def _plot_angles(plt, name, label, t, est, out) -> None:
     axes[1].plot(t, angles[:, 2], lw=0.7, color="C2", label="yaw")
     axes[1].set_ylabel("°")
     if est.mag_accepted is not None:
-        refused = ~est.mag_accepted
-        axes[1].fill_between(t, 0, 1, where=refused, transform=axes[1].get_xaxis_transform(), color="0.85",
-                             step="mid", label=f"field refused ({100 * refused.mean():.0f} % of samples)")
+        _shade_refused(axes[1], t, est)
         axes[1].set_title("yaw, from the magnetometer")
     else:
         axes[1].set_title("yaw, from the gyro (6D)")
@@ -116,13 +114,18 @@ def _plot_angles(plt, name, label, t, est, out) -> None:
     plt.close(fig)
 
 
+def _shade_refused(ax, t, est) -> None:
+    """Shade the samples whose field the disturbance guard refused."""
+    refused = ~est.mag_accepted
+    ax.fill_between(t, 0, 1, where=refused, transform=ax.get_xaxis_transform(), color="0.85", step="mid",
+                    label=f"field refused ({100 * refused.mean():.0f} % of samples)")
+
+
 def _heading_panel(ax, t, heading_error, est, rmse) -> None:
     """Heading error over time; shaded where the guard refused the field, lines where the
     hard-iron offset changed."""
     ax.plot(t, heading_error, lw=0.7, color="C1")
-    refused = ~est.mag_accepted
-    ax.fill_between(t, 0, 1, where=refused, transform=ax.get_xaxis_transform(), color="0.85", step="mid",
-                    label=f"field refused ({100 * refused.mean():.0f} % of samples)")
+    _shade_refused(ax, t, est)
     used = np.any(est.mag_offset != 0, axis=1)
     for i, k in enumerate(np.flatnonzero(used[1:] != used[:-1])):
         ax.axvline(t[k + 1], color="C3", lw=1.0, label=None if i else "hard-iron offset taken or dropped")
