@@ -171,16 +171,22 @@ def test_time_stamps_in_milliseconds_need_their_unit(tmp_path, recording, capsys
     assert np.allclose(milliseconds, seconds, rtol=0, atol=1e-9)
 
 
+def _kept_rows(n, seed, runs):
+    """(n, bool) rows a logger kept: False in `runs` dropouts of 1–29 rows from a fixed seed."""
+    rng = np.random.default_rng(seed)
+    keep = np.ones(n, dtype=bool)
+    for start in rng.integers(100, n - 100, runs):
+        keep[start:start + rng.integers(1, 30)] = False
+    return keep
+
+
 def test_missing_samples_are_filled_in_and_the_output_keeps_the_input_rows(tmp_path, recording, capsys):
     """30 runs of 1–29 dropped samples: filled in (gyro and accelerometer interpolated), the
     inclination error at the rows kept is at most 60 % of that of the same rows taken as
     uniform (the rotation during each gap lost; measured 5.8° against 11.0°, 1.4° with no
     sample dropped), and the output has the input's rows."""
     _, gyr, acc, up = recording
-    rng = np.random.default_rng(5)
-    keep = np.ones(len(gyr), dtype=bool)
-    for start in rng.integers(100, len(gyr) - 100, 30):
-        keep[start:start + rng.integers(1, 30)] = False
+    keep = _kept_rows(len(gyr), seed=5, runs=30)
     t = np.arange(1, len(gyr) + 1) / FS
     _write(tmp_path / "in.csv", t[keep], gyr[keep], acc[keep])
     data, err = _estimate_csv(tmp_path, capsys)
@@ -200,10 +206,7 @@ def test_rows_that_are_not_finite_are_filled_in_as_missing_samples_are(tmp_path,
     theirs; the output keeps every row. Such values in the first or last row, or in a run
     longer than --max-gap, are refused."""
     _, gyr, acc, _ = recording
-    rng = np.random.default_rng(6)
-    keep = np.ones(len(gyr), dtype=bool)
-    for start in rng.integers(100, len(gyr) - 100, 20):
-        keep[start:start + rng.integers(1, 30)] = False
+    keep = _kept_rows(len(gyr), seed=6, runs=20)
     t = np.arange(1, len(gyr) + 1) / FS
     _write(tmp_path / "in.csv", t[keep], gyr[keep], acc[keep])
     missing, _ = _estimate_csv(tmp_path, capsys)
