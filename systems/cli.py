@@ -15,7 +15,8 @@ from blocks.methods import METHODS
 from blocks.methods import method as known_method
 from blocks.stages import ESTIMATORS
 
-from .recording import ACC_UNITS, GYR_UNITS, MAG_UNITS, MAX_GAP_S, MOVEMENT_COLUMN, REF_COLUMNS, T_UNITS
+from .recording import (ACC_UNITS, GYR_UNITS, KNOWN_COLUMNS, MAG_UNITS, MAX_GAP_S, MOVEMENT_COLUMN, REF_COLUMNS,
+                        T_UNITS)
 
 EXIT_BAD_INPUT = 2
 EXIT_CHECK_FAILED = 1
@@ -31,6 +32,15 @@ def _param(text: str) -> tuple[str, float]:
     except ValueError:
         raise argparse.ArgumentTypeError(f"{name}: {value!r} is not a number") from None
     return name.strip(), number
+
+
+def _column(text: str) -> tuple[str, str]:
+    name, sep, header = text.partition("=")
+    if not sep or not header.strip():
+        raise argparse.ArgumentTypeError(f"expected NAME=HEADER (e.g. gyr_x=Gyr_X), got {text!r}")
+    if name.strip() not in KNOWN_COLUMNS:
+        raise argparse.ArgumentTypeError(f"{name!r} is not a column read; NAME is one of {', '.join(KNOWN_COLUMNS)}")
+    return name.strip(), header.strip()
 
 
 def _method_help() -> str:
@@ -62,6 +72,9 @@ def _add_input_flags(parser) -> None:
                         help="accelerometer unit (default m/s2; g and mg in standard gravity, 9.80665 m/s²)")
     parser.add_argument("--mag-unit", default="uT", choices=list(MAG_UNITS), help="magnetometer unit (default uT)")
     parser.add_argument("--t-unit", default="s", choices=list(T_UNITS), help="unit of a CSV's t column (default s)")
+    parser.add_argument("--column", type=_column, action="append", default=[], metavar="NAME=HEADER",
+                        help="read the CSV's column HEADER as NAME (t, gyr_x, acc_x, mag_x, ref_q_w, movement, ...), "
+                             "for a header with other names; repeatable")
     parser.add_argument("--max-gap", type=float, default=MAX_GAP_S, metavar="S",
                         help="longest run of samples missing from a CSV's time stamps, or of gyro or "
                              "accelerometer values that are not finite, that is filled in (interpolated "
@@ -78,8 +91,12 @@ def _add_input_flags(parser) -> None:
 
 
 def _read_options(args) -> dict:
+    names = [name for name, _ in args.column]
+    twice = sorted({name for name in names if names.count(name) > 1})
+    if twice:
+        raise ValueError(f"--column gives {', '.join(twice)} more than once")
     return {"fs": args.fs, "gyr_unit": args.gyr_unit, "acc_unit": args.acc_unit, "mag_unit": args.mag_unit,
-            "max_gap": args.max_gap, "t_unit": args.t_unit}
+            "max_gap": args.max_gap, "t_unit": args.t_unit, "columns": dict(args.column)}
 
 
 def build_parser() -> argparse.ArgumentParser:

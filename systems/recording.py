@@ -3,24 +3,27 @@ from __future__ import annotations
 
 import csv
 import math
+import re
+import shlex
 import warnings
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from blocks.earth_filters import STANDARD_GRAVITY
-
 DELIMITERS = (",", ";", "\t")  # the header's most frequent one; with ";" or a tab, "," is a decimal comma
 IMU_COLUMNS = ("gyr_x", "gyr_y", "gyr_z", "acc_x", "acc_y", "acc_z")
 MAG_COLUMNS = ("mag_x", "mag_y", "mag_z")
 REF_COLUMNS = ("ref_q_w", "ref_q_x", "ref_q_y", "ref_q_z")  # optional reference orientation, sensor → earth
 MOVEMENT_COLUMN = "movement"  # optional: 1 in the phase the errors are measured over, else 0
+KNOWN_COLUMNS = ("t", *IMU_COLUMNS, *MAG_COLUMNS, *REF_COLUMNS, MOVEMENT_COLUMN)  # the names a CSV's header may use
 OUTPUT_COLUMNS = ("t", "q_w", "q_x", "q_y", "q_z", "g_x", "g_y", "g_z")
 EULER_COLUMNS = ("roll_deg", "pitch_deg", "yaw_deg")  # with --euler
 GYR_UNITS = {"rad/s": 1.0, "deg/s": math.pi / 180.0, "mdeg/s": math.pi / 180e3}
-ACC_UNITS = {"m/s2": 1.0, "g": STANDARD_GRAVITY, "mg": STANDARD_GRAVITY / 1e3}
+G_N = 9.80665  # m/s², standard gravity: the unit g of accelerometers (not the local gravity of the filters)
+ACC_UNITS = {"m/s2": 1.0, "g": G_N, "mg": G_N / 1e3}
 MAG_UNITS = {"uT": 1.0, "nT": 1e-3, "G": 100.0, "mG": 0.1}  # to µT
 T_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}  # to s
 RATE_RANGE_HZ = (1.0, 1e5)  # sample rates an IMU recording can have; outside, the time unit is wrong
@@ -87,10 +90,12 @@ class Recording:
 
 
 def read_recording(path, fs: float | None = None, gyr_unit: str = "rad/s", acc_unit: str = "m/s2",
-                   mag_unit: str = "uT", max_gap: float = MAX_GAP_S, t_unit: str = "s") -> Recording:
+                   mag_unit: str = "uT", max_gap: float = MAX_GAP_S, t_unit: str = "s",
+                   columns: Mapping[str, str] | None = None) -> Recording:
     """Read a CSV (header t,gyr_x..z,acc_x..z[,mag_x..z][,ref_q_w..z][,movement]; t may be
     replaced by fs) or a BROAD .mat, in the units given (GYR_UNITS, ACC_UNITS, MAG_UNITS,
-    T_UNITS), into rad/s, m/s², µT and s. A CSV's time stamps may jitter and skip samples:
+    T_UNITS), into rad/s, m/s², µT and s. columns ({our name: the CSV's}) reads a header
+    with other names (a logger's export) without editing the file. A CSV's time stamps may jitter and skip samples:
     runs of missing samples up to max_gap seconds are filled in (_fill_gaps), longer ones
     refused; so are runs of gyro or accelerometer values that are not finite
     (_fill_non_finite)."""
@@ -104,7 +109,19 @@ def read_recording(path, fs: float | None = None, gyr_unit: str = "rad/s", acc_u
         raise RecordingError(f"the sample rate must be a finite positive number of Hz, got {fs!r}")
     if not (math.isfinite(max_gap) and max_gap >= 0):
         raise RecordingError(f"the longest gap to fill must be a finite number of seconds ≥ 0, got {max_gap!r}")
-    rec = _read_mat(path, fs) if path.suffix.lower() == ".mat" else _read_csv(path, fs, max_gap, T_UNITS[t_unit])
+    columns = dict(columns or {})
+    unknown = [name for name in columns if name not in KNOWN_COLUMNS]
+    if unknown:
+        raise RecordingError(f"--column names {', '.join(unknown)}; the columns read are {', '.join(KNOWN_COLUMNS)}")
+    shared = sorted({c for c in columns.values() if list(columns.values()).count(c) > 1})
+    if shared:
+        raise RecordingError(f"--column gives the file's column {', '.join(shared)} more than one name")
+    if path.suffix.lower() == ".mat":
+        if columns:
+            raise RecordingError(f"{path}: --column renames a CSV's columns; a .mat has BROAD's variables")
+        rec = _read_mat(path, fs)
+    else:
+        rec = _read_csv(path, fs, max_gap, T_UNITS[t_unit], columns)
     if fs is not None and abs(rec.fs - fs) > 0.01 * fs:
         raise RecordingError(f"{path}: --fs {fs:g} Hz disagrees with the recording's {rec.fs:g} Hz")
     rec.gyr = rec.gyr * GYR_UNITS[gyr_unit]
@@ -138,7 +155,7 @@ def field_norm_note(rec: Recording) -> str | None:
             "works in any unit; the hard-iron offset is reported in the input's")
 
 
-def _read_csv(path: Path, fs: float | None, max_gap: float, t_scale: float) -> Recording:
+def _read_csv(path: Path, fs: float | None, max_gap: float, t_scale: float, columns: dict) -> Recording:
     with path.open(newline="", encoding="utf-8-sig") as fh:  # a spreadsheet's byte-order mark is not a name
         first = fh.readline()
     delimiter = max(DELIMITERS, key=first.count)
@@ -146,16 +163,19 @@ def _read_csv(path: Path, fs: float | None, max_gap: float, t_scale: float) -> R
     if not header:
         raise RecordingError(f"{path}: empty file; expected a header t,{','.join(IMU_COLUMNS)}")
     header = [h.strip() for h in header]
+    header[0] = header[0].lstrip("#").strip()  # a header marked as a comment (numpy.savetxt's default)
+    header = _renamed(path, header, columns)
     missing = [c for c in IMU_COLUMNS if c not in header]
     if missing:
-        raise RecordingError(f"{path}: missing columns {', '.join(missing)} (header: {','.join(header)})")
+        raise RecordingError(f"{path}: missing columns {', '.join(missing)} (header: {','.join(header)})"
+                             f"{_column_hint(missing, header)}")
     for group, what in ((MAG_COLUMNS, "the magnetometer"), (REF_COLUMNS, "the reference")):
         given = [c for c in group if c in header]
         if given and len(given) < len(group):
             raise RecordingError(f"{path}: {what} needs all of {','.join(group)}, "
                                  f"the header has only {','.join(given)}")
     if "t" not in header and fs is None:
-        raise RecordingError(f"{path}: no 't' column; give the sample rate with --fs HZ")
+        raise RecordingError(f"{path}: no 't' column; give the sample rate with --fs HZ{_column_hint(['t'], header)}")
     try:
         with warnings.catch_warnings():  # no rows: said below, not as numpy's warning
             warnings.simplefilter("ignore", UserWarning)
@@ -173,9 +193,10 @@ def _read_csv(path: Path, fs: float | None, max_gap: float, t_scale: float) -> R
                     None if "t" not in col else col["t"] * t_scale,
                     columns(MAG_COLUMNS), columns(REF_COLUMNS),
                     None if movement is None else _flag(path, MOVEMENT_COLUMN, movement))
-    unknown = [c for c in header if c not in ("t", *IMU_COLUMNS, *MAG_COLUMNS, *REF_COLUMNS, MOVEMENT_COLUMN)]
+    unknown = [c for c in header if c not in KNOWN_COLUMNS]
     if unknown:
-        rec.notes.append(f"{rec.name}: columns not read: {', '.join(unknown)}")
+        absent = [c for c in KNOWN_COLUMNS if c not in header]
+        rec.notes.append(f"{rec.name}: columns not read: {', '.join(unknown)}{_column_hint(absent, unknown)}")
     if rec.t is None:
         rec.fs, rec.t = float(fs), np.arange(1, data.shape[0] + 1) / fs
         return rec
@@ -188,6 +209,30 @@ def _read_csv(path: Path, fs: float | None, max_gap: float, t_scale: float) -> R
     if index[-1] + 1 > len(index):
         rec = _fill_gaps(rec, index)
     return rec
+
+
+def _renamed(path: Path, header: list[str], columns: dict) -> list[str]:
+    """header with the names columns maps ({ours: the file's}) replaced by ours; a column
+    of the file that has one of those names already is left unread. Names read twice are
+    refused."""
+    absent = [theirs for theirs in columns.values() if theirs not in header]
+    if absent:
+        raise RecordingError(f"{path}: --column names {', '.join(absent)}, not in the header ({','.join(header)})")
+    ours = {theirs: name for name, theirs in columns.items()}
+    header = [ours.get(h, f"{h} (replaced by --column)" if h in columns else h) for h in header]
+    twice = sorted({h for h in header if h in KNOWN_COLUMNS and header.count(h) > 1})
+    if twice:
+        raise RecordingError(f"{path}: the header has {', '.join(twice)} more than once")
+    return header
+
+
+def _column_hint(wanted, header) -> str:
+    """The --column flags that would read header names equal to wanted ones but for case,
+    spaces and punctuation (Gyr_X, GyrX, "gyr x" for gyr_x), as a hint."""
+    key = lambda name: re.sub(r"[^a-z0-9]", "", name.lower())
+    found = {key(h): h for h in header}
+    flags = [f"--column {shlex.quote(f'{c}={found[key(c)]}')}" for c in wanted if key(c) in found]
+    return f"; to read them pass {' '.join(flags)}" if flags else ""
 
 
 def _sample_grid(path: Path, t: np.ndarray, max_gap: float) -> tuple[np.ndarray, float, float]:

@@ -84,7 +84,7 @@ def test_estimate_without_t_column_needs_fs_and_honours_units(tmp_path, imu):
     ref = estimate(gyr, acc, FS, "first_order", gyro_offset=True)
     out = tmp_path / "out.csv"
     for gyr_unit, acc_unit, scale in (("deg/s", "g", 1.0), ("mdeg/s", "mg", 1e3)):
-        _write_csv(tmp_path / "in.csv", _imu_columns(np.degrees(gyr) * scale, acc / 9.81 * scale, with_t=False))
+        _write_csv(tmp_path / "in.csv", _imu_columns(np.degrees(gyr) * scale, acc / 9.80665 * scale, with_t=False))
         assert main(["estimate", str(tmp_path / "in.csv"), "--out", str(out)]) == 2
         assert main(["estimate", str(tmp_path / "in.csv"), "--out", str(out), "--fs", "100",
                      "--gyr-unit", gyr_unit, "--acc-unit", acc_unit, "--method", "first_order"]) == 0

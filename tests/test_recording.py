@@ -2,6 +2,7 @@
 reference orientation in a CSV, evaluated as a BROAD .mat is."""
 import json
 import math
+import shlex
 import warnings
 
 import numpy as np
@@ -100,6 +101,61 @@ def test_columns_it_cannot_use_are_refused_or_named(tmp_path, recording, capsys)
         warnings.simplefilter("error")
         assert main(["estimate", str(tmp_path / "in.csv"), "--out", str(tmp_path / "out.csv")]) == 2
     assert "expected 7 columns of numbers and at least one row" in capsys.readouterr().err
+
+
+def test_a_loggers_header_is_read_through_column_names(tmp_path, recording, capsys):
+    """A logger's export (Xsens-style names, deg/s and g, no t) is refused with the
+    --column flags that read it, and read with them gives our CSV's estimate; so does a
+    header marked as a comment with spaces in its names and t in ns (EuRoC-style). A
+    column of the file that has a name given to another is left unread and noted;
+    a name given twice, a header name not in the file, one given two names, a name not
+    read and --column on a .mat are refused."""
+    _, gyr, acc, _ = recording
+    n = 1000
+    t = np.arange(1, n + 1) / FS
+    _write(tmp_path / "in.csv", t, gyr[:n], acc[:n])
+    ours, _ = _estimate_csv(tmp_path, capsys)
+    export = tmp_path / "export.csv"
+    np.savetxt(export, np.column_stack([np.arange(n), acc[:n] / 9.80665, np.degrees(gyr[:n])]), delimiter=",",
+               header="PacketCounter,Acc_X,Acc_Y,Acc_Z,Gyr_X,Gyr_Y,Gyr_Z", comments="", fmt="%.17g")
+    flags = ["--fs", str(FS), "--gyr-unit", "deg/s", "--acc-unit", "g"]
+    out = tmp_path / "out.csv"
+    assert main(["estimate", str(export), "--out", str(out), *flags]) == 2
+    err = capsys.readouterr().err
+    assert "missing columns gyr_x, gyr_y, gyr_z, acc_x, acc_y, acc_z" in err, err
+    hinted = shlex.split(err.split("to read them pass ")[1])
+    assert hinted == [x for c in ("gyr", "acc") for a in "xyz" for x in ("--column", f"{c}_{a}={c.title()}_{a.upper()}")]
+    assert main(["estimate", str(export), "--out", str(out), *flags, *hinted]) == 0
+    assert "columns not read: PacketCounter" in capsys.readouterr().err
+    assert np.abs(np.loadtxt(out, delimiter=",", skiprows=1)[:, 1:] - ours[:, 1:]).max() < 1e-9
+
+    names = ["timestamp [ns]", *(f"{s}_RS_S_{a} [{u}]" for s, u in (("w", "rad s^-1"), ("a", "m s^-2")) for a in "xyz")]
+    euroc = tmp_path / "euroc.csv"
+    np.savetxt(euroc, np.column_stack([np.round(t * 1e9), gyr[:n], acc[:n]]), delimiter=",", header=",".join(names),
+               fmt="%.17g")  # numpy's default comments="# "
+    renames = [x for ours_name, theirs in zip(("t", *IMU_COLUMNS), names) for x in ("--column", f"{ours_name}={theirs}")]
+    assert main(["estimate", str(euroc), "--out", str(out), "--t-unit", "ns", *renames]) == 0
+    assert np.abs(np.loadtxt(out, delimiter=",", skiprows=1) - ours).max() < 1e-9
+    capsys.readouterr()
+
+    _write(tmp_path / "in.csv", t, gyr[:n], acc[:n], {"time": t + 5.0})  # t, and the logger's own time
+    shifted, err = _estimate_csv(tmp_path, capsys, "--column", "t=time")
+    assert "columns not read: t (replaced by --column)" in err, err
+    assert np.allclose(shifted[:, 0], ours[:, 0] + 5.0) and np.array_equal(shifted[:, 1:], ours[:, 1:])
+    savemat(tmp_path / "in.mat", {"imu_gyr": gyr[:n], "imu_acc": acc[:n], "sampling_rate": FS})
+    refused = {
+        ("--column", "gyr_x=time", "--column", "gyr_x=t"): "--column gives gyr_x more than once",
+        ("--column", "gyr_x=temp"): "--column names temp, not in the header",
+        ("--column", "gyr_x=time", "--column", "gyr_y=time"): "--column gives the file's column time more than one name",
+    }
+    for flags_given, message in refused.items():
+        assert main(["estimate", str(tmp_path / "in.csv"), "--out", str(out), *flags_given]) == 2
+        assert message in capsys.readouterr().err, message
+    assert main(["estimate", str(tmp_path / "in.mat"), "--out", str(out), "--column", "t=time"]) == 2
+    assert "--column renames a CSV's columns; a .mat has BROAD's variables" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        main(["estimate", str(tmp_path / "in.csv"), "--out", str(out), "--column", "gyro_x=time"])
+    assert "'gyro_x' is not a column read" in capsys.readouterr().err
 
 
 def test_mat_files_with_a_transposed_array_no_rate_or_no_magnetometer_sample(tmp_path, recording, capsys):
