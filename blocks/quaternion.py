@@ -99,3 +99,13 @@ def write_sample(gravity, quat, k, g, up, q):
     """Row k of a kernel method's output: gravity g·up (m/s²) and the orientation q."""
     gravity[k, 0], gravity[k, 1], gravity[k, 2] = g * up[0], g * up[1], g * up[2]
     quat[k, 0], quat[k, 1], quat[k, 2], quat[k, 3] = q[0], q[1], q[2], q[3]
+
+
+@kernel()
+def integrate_rates(gyr, Ts, quat):
+    """quat[k] (N×4): the orientation after gyro sample k (N×3 mean rates, rad/s, over Ts
+    seconds each) from the identity before the first, q ← q ⊗ exp(ω·Ts)."""
+    q = (1.0, 0.0, 0.0, 0.0)
+    for k in range(gyr.shape[0]):
+        q = quat_normalized(quat_multiply(q, rotvec_quat(gyr[k, 0] * Ts, gyr[k, 1] * Ts, gyr[k, 2] * Ts)))
+        quat[k, 0], quat[k, 1], quat[k, 2], quat[k, 3] = q[0], q[1], q[2], q[3]

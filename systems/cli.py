@@ -43,6 +43,16 @@ def _column(text: str) -> tuple[str, str]:
     return name.strip(), header.strip()
 
 
+def _axes(text: str) -> str:
+    from .axes import parse_axes
+
+    try:
+        parse_axes(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+    return text
+
+
 def _method_help() -> str:
     lines = []
     stages = [(f"{m.name}: {m.summary}", m.params) for m in METHODS.values()]
@@ -75,6 +85,11 @@ def _add_input_flags(parser) -> None:
     parser.add_argument("--column", type=_column, action="append", default=[], metavar="NAME=HEADER",
                         help="read the CSV's column HEADER as NAME (t, gyr_x, acc_x, mag_x, ref_q_w, movement, ...), "
                              "for a header with other names; repeatable")
+    for sensor, what in (("gyr", "gyro"), ("acc", "accelerometer"), ("mag", "magnetometer")):
+        parser.add_argument(f"--{sensor}-axes", type=_axes, metavar="MAP",
+                            help=f"the {what}'s axes as the file's, signed: y,x,-z takes x from the file's y, y from "
+                                 "its x and z from its −z (default x,y,z); a sensor that does not turn as the gyro "
+                                 "says is noted with the maps that fit")
     parser.add_argument("--max-gap", type=float, default=MAX_GAP_S, metavar="S",
                         help="longest run of samples missing from a CSV's time stamps, or of gyro or "
                              "accelerometer values that are not finite, that is filled in (interpolated "
@@ -96,7 +111,8 @@ def _read_options(args) -> dict:
     if twice:
         raise ValueError(f"--column gives {', '.join(twice)} more than once")
     return {"fs": args.fs, "gyr_unit": args.gyr_unit, "acc_unit": args.acc_unit, "mag_unit": args.mag_unit,
-            "max_gap": args.max_gap, "t_unit": args.t_unit, "columns": dict(args.column)}
+            "max_gap": args.max_gap, "t_unit": args.t_unit, "columns": dict(args.column),
+            "gyr_axes": args.gyr_axes, "acc_axes": args.acc_axes, "mag_axes": args.mag_axes}
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -188,7 +204,7 @@ def _check_out(path, source=None) -> None:
 
 def cmd_estimate(args) -> int:
     from .batch import estimate
-    from .recording import field_norm_note, read_recording, write_estimate
+    from .recording import field_norm_note, print_notes, read_recording, write_estimate
 
     _check_out(args.out, args.input)
     clock = time.perf_counter()
@@ -201,9 +217,7 @@ def cmd_estimate(args) -> int:
 
     rec = read_recording(args.input, **_read_options(args))
     progress(f"read {len(rec.gyr)} samples at {rec.fs:g} Hz from {args.input}")
-    for note in rec.notes + ([field_norm_note(rec)] if args.heading == "mag" else []):
-        if note:
-            print(f"attitude: note: {note}", file=sys.stderr)
+    print_notes(rec.notes + ([field_norm_note(rec)] if args.heading == "mag" else []))
     result = estimate(rec.gyr, rec.acc, rec.fs, args.method, dict(args.param), offline=args.offline,
                       gyro_offset=args.gyro_offset == "on", mag=rec.mag if args.heading == "mag" else None,
                       latency=args.latency, gyr_samples=args.gyr_samples)

@@ -16,7 +16,7 @@ from blocks.timing import carry_forward_rows, check_gyr_samples, check_latency, 
 from .batch import estimate
 from .compare import peer_quaternions
 from .errors import quaternion_errors
-from .recording import Recording, read_recording
+from .recording import Recording, print_notes, read_recording
 
 METRICS = ("total_rmse_deg", "heading_rmse_deg", "inclination_rmse_deg")
 LATENCY_SEARCH_S = 0.1  # imu_latency looks this far either way
@@ -121,9 +121,8 @@ def evaluate(paths, method: str = "wiener", params=None, offline: bool = False, 
             rec = rec.into_movement(start_in_movement)
         rec.evaluated()
         if progress:
-            for note in rec.notes + ([f"{rec.name}: no movement flag; errors over every sample with a reference"]
-                                     if rec.movement is None else []):
-                print(f"attitude: note: {note}", file=sys.stderr)
+            print_notes(rec.notes + ([f"{rec.name}: no movement flag; errors over every sample with a reference"]
+                                     if rec.movement is None else []))
         read.append((path, rec))
     names = [rec.name for _, rec in read]
     if len(set(names)) < len(names):  # files of one name from several folders: keyed by path

@@ -14,7 +14,7 @@ from blocks.stages import split_params
 
 from .batch import estimate
 from .errors import quaternion_errors
-from .recording import RecordingError, euler_degrees, read_recording
+from .recording import RecordingError, euler_degrees, print_notes, read_recording
 
 
 def plot_recording(path, out, method: str = "wiener", params=None, offline: bool = False,
@@ -27,14 +27,15 @@ def plot_recording(path, out, method: str = "wiener", params=None, offline: bool
     Returns the inclination and (with the magnetometer) heading RMSE (deg) over the
     movement phase (Recording.evaluated). A recording without a reference gets the
     estimate's roll, pitch and yaw over time instead (and the gyro offset estimate), and
-    an empty dict. read_options: keyword arguments of read_recording; latency (s) and
-    gyr_samples: as systems.batch.estimate's."""
+    an empty dict. read_options: keyword arguments of read_recording (its notes go to
+    standard error); latency (s) and gyr_samples: as systems.batch.estimate's."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     rec = read_recording(path, **(read_options or {}))
+    print_notes(rec.notes)
     valid = None if rec.quat_ref is None else rec.evaluated()
     if valid is not None and valid.sum() < 16:
         raise RecordingError(f"{rec.name}: too few valid reference samples to plot")

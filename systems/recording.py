@@ -5,6 +5,7 @@ import csv
 import math
 import re
 import shlex
+import sys
 import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
@@ -12,6 +13,8 @@ from pathlib import Path
 
 import numpy as np
 from scipy.spatial.transform import Rotation
+
+from .axes import axes_notes, parse_axes
 
 DELIMITERS = (",", ";", "\t")  # the header's most frequent one; with ";" or a tab, "," is a decimal comma
 IMU_COLUMNS = ("gyr_x", "gyr_y", "gyr_z", "acc_x", "acc_y", "acc_z")
@@ -91,11 +94,15 @@ class Recording:
 
 def read_recording(path, fs: float | None = None, gyr_unit: str = "rad/s", acc_unit: str = "m/s2",
                    mag_unit: str = "uT", max_gap: float = MAX_GAP_S, t_unit: str = "s",
-                   columns: Mapping[str, str] | None = None) -> Recording:
+                   columns: Mapping[str, str] | None = None, gyr_axes: str | None = None,
+                   acc_axes: str | None = None, mag_axes: str | None = None) -> Recording:
     """Read a CSV (header t,gyr_x..z,acc_x..z[,mag_x..z][,ref_q_w..z][,movement]; t may be
     replaced by fs) or a BROAD .mat, in the units given (GYR_UNITS, ACC_UNITS, MAG_UNITS,
     T_UNITS), into rad/s, m/s², µT and s. columns ({our name: the CSV's}) reads a header
-    with other names (a logger's export) without editing the file. A CSV's time stamps may jitter and skip samples:
+    with other names (a logger's export) without editing the file. gyr_axes, acc_axes,
+    mag_axes: signed axis maps into the output's frame (systems.axes.parse_axes); an
+    accelerometer or magnetometer that does not turn as the gyro says is noted
+    (systems.axes.axes_notes). A CSV's time stamps may jitter and skip samples:
     runs of missing samples up to max_gap seconds are filled in (_fill_gaps), longer ones
     refused; so are runs of gyro or accelerometer values that are not finite
     (_fill_non_finite)."""
@@ -109,6 +116,8 @@ def read_recording(path, fs: float | None = None, gyr_unit: str = "rad/s", acc_u
         raise RecordingError(f"the sample rate must be a finite positive number of Hz, got {fs!r}")
     if not (math.isfinite(max_gap) and max_gap >= 0):
         raise RecordingError(f"the longest gap to fill must be a finite number of seconds ≥ 0, got {max_gap!r}")
+    maps = {name: parse_axes(text) for name, text in (("gyr", gyr_axes), ("acc", acc_axes), ("mag", mag_axes))
+            if text is not None}
     columns = dict(columns or {})
     unknown = [name for name in columns if name not in KNOWN_COLUMNS]
     if unknown:
@@ -135,7 +144,18 @@ def read_recording(path, fs: float | None = None, gyr_unit: str = "rad/s", acc_u
     _check_rate(rec.name, rec.fs)
     _fill_non_finite(rec, max_gap)
     _check_values(rec, gyr_unit, acc_unit)
+    for name, matrix in maps.items():
+        if getattr(rec, name) is not None:
+            setattr(rec, name, getattr(rec, name) @ matrix.T)
+    rec.notes += axes_notes(rec.name, rec.gyr, rec.acc, rec.mag, rec.fs)
     return rec
+
+
+def print_notes(notes) -> None:
+    """Notes on how a recording was read (None entries skipped), on standard error."""
+    for note in notes:
+        if note:
+            print(f"attitude: note: {note}", file=sys.stderr)
 
 
 def field_norm_note(rec: Recording) -> str | None:

@@ -107,3 +107,19 @@ def test_the_imu_trails_the_reference_alike_in_every_file_and_latency_compensati
     for label, row in carried.items():
         assert row["inclination_rmse_deg"] < table["mean"][label]["inclination_rmse_deg"], label
     assert carried["wiener"]["inclination_rmse_deg"] < carried["vqf"]["inclination_rmse_deg"]
+
+
+def test_the_recordings_axes_pass_the_axis_check_and_a_swapped_magnetometer_is_named():
+    """BROAD's sensors share their axes: no axis note on any recording (systems.axes). Its
+    magnetometer read as an MPU-9250's (x, y swapped, z reversed) is named with the flag
+    that maps it back in every trial that turns (rotation, combined, tapping, vibration, a
+    magnet nearby); not in the translation trials, which turn too little to tell, nor
+    where a magnet on the board outweighs the earth's field."""
+    from systems.axes import axes_notes, parse_axes
+
+    for path in FILES:
+        rec = read_recording(path)
+        assert not [n for n in rec.notes if "does not turn" in n], rec.name
+        notes = axes_notes(rec.name, rec.gyr, rec.acc, rec.mag @ parse_axes("y,x,-z"), rec.fs)
+        turning = any(kind in rec.name for kind in ("rotation", "combined", "tapping", "vibration", "stationary"))
+        assert len(notes) == turning and all("--mag-axes y,x,-z" in n for n in notes), (rec.name, notes)

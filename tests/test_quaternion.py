@@ -51,3 +51,17 @@ def test_carry_forward_matches_scipy():
     assert np.abs(up - turn.inv().apply(gravity)).max() < 1e-13
     # the up-vector and the orientation stay consistent: both give the same earth vector
     assert np.abs(Rotation.from_quat(quat, scalar_first=True).apply(up) - rot.apply(gravity)).max() < 1e-12
+
+
+def test_integrated_rates_rebuild_a_closed_form_motion():
+    """A closed-form coning motion's gyro (the rotation vector of each sample's interval)
+    integrated from the identity gives its orientations relative to the first."""
+    from blocks.quaternion import integrate_rates
+    from systems.motion import coning
+
+    motion = coning().generate(60.0, 100.0)
+    quat = np.empty_like(motion.quat)
+    integrate_rates(np.ascontiguousarray(motion.gyr[1:]), 0.01, quat[1:])
+    quat[0] = (1.0, 0.0, 0.0, 0.0)
+    truth = Rotation.from_quat(motion.quat[0], scalar_first=True).inv() * Rotation.from_quat(motion.quat, scalar_first=True)
+    assert (Rotation.from_quat(quat, scalar_first=True).inv() * truth).magnitude().max() < 1e-9
