@@ -131,6 +131,10 @@ def build_parser() -> argparse.ArgumentParser:
     est.add_argument("--out", required=True, help="output CSV: t,q_w,q_x,q_y,q_z,g_x,g_y,g_z")
     est.add_argument("--euler", action="store_true",
                      help="add roll_deg,pitch_deg,yaw_deg to the output (Z-Y-X sequence of q, degrees)")
+    est.add_argument("--offsets", action="store_true",
+                     help="add gyr_offset_x,gyr_offset_y,gyr_offset_z (rad/s, the gyro-offset estimate after each "
+                          "sample; 0 with --gyro-offset off) and, with magnetometer heading, mag_offset_x,mag_offset_y,"
+                          "mag_offset_z (µT, the hard-iron estimate)")
     est.add_argument("--method", default="wiener", choices=sorted(METHODS))
     est.add_argument("--param", type=_param, action="append", default=[], metavar="NAME=VALUE",
                      help="parameter of the method, the gyro-offset or the heading estimator, in the unit listed "
@@ -223,7 +227,13 @@ def cmd_estimate(args) -> int:
                       latency=args.latency, gyr_samples=args.gyr_samples)
     progress(f"estimated with {args.method}{' --offline' if args.offline else ''}")
     rows = slice(None) if rec.filled is None else ~rec.filled  # the input's rows, not those filled in
-    write_estimate(args.out, rec.t[rows], result.quat[rows], result.up[rows], euler=args.euler)
+    extra = {}
+    if args.offsets:
+        extra["gyr_offset"] = np.zeros_like(rec.gyr) if result.offset is None else result.offset
+        if result.mag_offset is not None:
+            extra["mag_offset"] = result.mag_offset
+    write_estimate(args.out, rec.t[rows], result.quat[rows], result.up[rows], euler=args.euler,
+                   extra={name: values[rows] for name, values in extra.items()})
     progress(f"wrote {args.out}")
     if result.offset is not None:
         print("attitude: gyro offset estimate at the end "

@@ -454,11 +454,15 @@ def euler_degrees(quat) -> np.ndarray:
     return Rotation.from_quat(quat, scalar_first=True).as_euler("ZYX", degrees=True)[:, ::-1]
 
 
-def write_estimate(path, t, quat, up, euler: bool = False) -> None:
+def write_estimate(path, t, quat, up, euler: bool = False, extra=None) -> None:
     """CSV with columns t,q_w,q_x,q_y,q_z,g_x,g_y,g_z (g the unit up-vector, sensor
-    coordinates); euler adds roll, pitch and yaw in degrees (EULER_COLUMNS, euler_degrees)."""
+    coordinates); euler adds roll, pitch and yaw in degrees (EULER_COLUMNS, euler_degrees);
+    extra ({prefix: N×3}) adds prefix_x,prefix_y,prefix_z after them."""
     columns, table = OUTPUT_COLUMNS, [t, quat, up]
     if euler:
         columns = columns + EULER_COLUMNS
         table.append(euler_degrees(quat))
+    for prefix, values in (extra or {}).items():
+        columns = columns + tuple(f"{prefix}_{a}" for a in "xyz")
+        table.append(values)
     np.savetxt(path, np.column_stack(table), delimiter=",", header=",".join(columns), comments="", fmt="%.10g")
