@@ -34,6 +34,8 @@ EARTH_FIELD_RANGE_UT = (20.0, 70.0)  # the geomagnetic field's norm anywhere on 
 MAX_GYRO_RAD_S = 40.0  # beyond the ±2000 °/s range of MEMS gyros: such values are not rad/s
 MAX_GAP_S = 1.0  # longest run of missing samples filled in by default (s)
 UNIT_TOLERANCE = 0.1  # largest departure of a reference quaternion's norm from 1 (rounded columns pass)
+SATURATION_S = 0.02  # s: a run this long at exactly a column's largest magnitude is the sensor's range
+SATURATION_LEAST = {"gyr": 2.0, "acc": 15.0}  # rad/s, m/s²: below every MEMS range (±125 °/s, ±2 g)
 JITTER_NOTE = 0.1  # time stamps off the uniform grid by more than this share of a step are noted
 
 
@@ -144,6 +146,7 @@ def read_recording(path, fs: float | None = None, gyr_unit: str = "rad/s", acc_u
     _check_rate(rec.name, rec.fs)
     _fill_non_finite(rec, max_gap)
     _check_values(rec, gyr_unit, acc_unit)
+    rec.notes += _saturation_notes(rec)
     for name, matrix in maps.items():
         if getattr(rec, name) is not None:
             setattr(rec, name, getattr(rec, name) @ matrix.T)
@@ -426,6 +429,32 @@ def _fill_non_finite(rec: Recording, max_gap: float) -> None:
     rec.notes.append(f"{rec.name}: {len(rows)} rows with gyro or accelerometer values that are not finite, in "
                      f"{len(starts)} run{'s' * (len(starts) > 1)} (the longest "
                      f"{(ends[longest] - starts[longest] + 1) / rec.fs:g} s), interpolated linearly")
+
+
+def _saturation_notes(rec: Recording) -> list[str]:
+    """A note per sensor with an axis held at exactly its largest magnitude (at least
+    SATURATION_LEAST) for SATURATION_S or longer: its range, beyond which it misses the
+    motion. A smooth peak within the range holds one value for a few ms at most, however
+    fine the sampling. An axis that repeats its values half the time elsewhere (a
+    noise-free simulation: exact zeros at rest, a turntable's constant rate throughout) is
+    not taken for a clipped one."""
+    notes = []
+    for name, what, unit in (("gyr", "gyro", "rad/s"), ("acc", "accelerometer", "m/s²")):
+        clipped = []
+        for axis, column in zip("xyz", np.abs(getattr(rec, name)).T):
+            peak = float(column.max())
+            held = column == peak
+            edges = np.diff(np.concatenate([[0], held.astype(np.int8), [0]]))
+            longest = int((np.flatnonzero(edges < 0) - np.flatnonzero(edges > 0)).max())
+            others = column[~held]
+            repeats = np.mean(others[1:] == others[:-1]) if len(others) > 1 else 1.0
+            if peak >= SATURATION_LEAST[name] and longest >= max(3, SATURATION_S * rec.fs) and repeats < 0.5:
+                clipped.append(f"{axis} at ±{peak:.4g} {unit} for up to {1e3 * longest / rec.fs:.0f} ms "
+                               f"({int(held.sum())} samples)")
+        if clipped:
+            notes.append(f"{rec.name}: the {what} stays at its largest value on {'; '.join(clipped)}: its range? "
+                         "Where it saturates the estimate misses the motion beyond it; record with a wider range")
+    return notes
 
 
 def _check_values(rec: Recording, gyr_unit: str, acc_unit: str) -> None:

@@ -158,6 +158,47 @@ def test_a_loggers_header_is_read_through_column_names(tmp_path, recording, caps
     assert "'gyro_x' is not a column read" in capsys.readouterr().err
 
 
+def test_a_sensor_held_at_its_range_is_noted(tmp_path):
+    """A gyro of ±125 °/s on vigorous human motion and an accelerometer of ±2 g on a ±90°
+    swing at 0.5 Hz at the end of a 1 m arm (16-bit and 1 mg samples) stay at their range for tens
+    of ms: each is noted with its axes and value. The same samples unclipped are not; nor
+    are a 1 kHz recording of a ±90° swing at 1 Hz (a smooth peak of 565 °/s, where 16-bit
+    samples of ±2000 °/s hold one value for a few ms) and a noise-free turntable at a
+    steady 3 rad/s (16-bit samples, which hold it exactly), throughout or after 40 s at rest."""
+    from scipy.spatial.transform import Rotation
+
+    from systems.motion import ClosedFormMotion, offset_rotation, sine_rotation, steady_lever_arm
+
+    lsb = math.radians(2000.0) / 32768
+    quantized = lambda g, a: (np.round(g / lsb) * lsb, np.round(a / 1e-3) * 1e-3)
+    sensor = ImuModel(delta_n=math.radians(0.05), acc_noise=0.002)
+    human = quantized(*sensor.apply(HumanMotion(delta_v=0.2, omega_c=5.0).generate(60.0, FS, seed=8), seed=9))
+    arm = quantized(*sensor.apply(offset_rotation(frequency=0.5, amplitude_deg=90.0, radius=1.0).generate(60.0, FS),
+                                  seed=9))
+    gyr_limit = math.radians(125.0)
+    swing = sine_rotation(amplitude_deg=90.0, frequency=1.0).generate(30.0, 1000.0)
+    assert np.abs(swing.gyr).max() > math.radians(560.0)
+    turntable = steady_lever_arm(rate=3.0).generate(60.0, FS)
+    started = ClosedFormMotion("started", lambda t: Rotation.from_rotvec(np.outer(3.0 * np.maximum(t - 40.0, 0.0), [0, 0, 1])),
+                               lambda t: np.zeros((len(t), 3))).generate(60.0, FS)
+    gyr_limit = math.radians(125.0)
+    cases = [  # (name, (gyr, acc), the note, rate)
+        ("gyro", (np.clip(human[0], -gyr_limit, gyr_limit), human[1]),
+         "the gyro stays at its largest value on x at ±2.182 rad/s", FS),
+        ("acc", (arm[0], np.clip(arm[1], -19.6133, 19.6133)),
+         "the accelerometer stays at its largest value on x at ±19.61 m/s²", FS),
+        ("human", human, None, FS),
+        ("arm", arm, None, FS),
+        ("swing", quantized(swing.gyr, swing.acc), None, 1000.0),
+        ("turntable", quantized(turntable.gyr, turntable.acc), None, FS),
+        ("started", quantized(started.gyr, started.acc), None, FS),
+    ]
+    for name, (gyr, acc), noted, fs in cases:
+        savemat(tmp_path / "in.mat", {"imu_gyr": gyr, "imu_acc": acc, "sampling_rate": fs})
+        notes = " ".join(read_recording(tmp_path / "in.mat").notes)
+        assert (noted in notes) if noted else ("largest value" not in notes), (name, notes)
+
+
 def test_mat_files_with_a_transposed_array_no_rate_or_no_magnetometer_sample(tmp_path, recording, capsys):
     """A 3×N array is refused with the hint to transpose it; a file without sampling_rate
     reads at --fs; a magnetometer that is NaN throughout is noted and left out (6D), as
