@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import csv
+import itertools
 import math
 import re
 import shlex
@@ -36,6 +37,7 @@ MAX_GAP_S = 1.0  # longest run of missing samples filled in by default (s)
 UNIT_TOLERANCE = 0.1  # largest departure of a reference quaternion's norm from 1 (rounded columns pass)
 SATURATION_S = 0.02  # s: a run this long at exactly a column's largest magnitude is the sensor's range
 SATURATION_LEAST = {"gyr": 2.0, "acc": 15.0}  # rad/s, m/s²: below every MEMS range (±125 °/s, ±2 g)
+MAX_LABEL_ROWS = 3  # rows without a number after the header that are skipped (units); more: refused
 JITTER_NOTE = 0.1  # time stamps off the uniform grid by more than this share of a step are noted
 
 
@@ -199,12 +201,13 @@ def _read_csv(path: Path, fs: float | None, max_gap: float, t_scale: float, colu
                                  f"the header has only {','.join(given)}")
     if "t" not in header and fs is None:
         raise RecordingError(f"{path}: no 't' column; give the sample rate with --fs HZ{_column_hint(['t'], header)}")
+    labels = _label_rows(path, delimiter)
     try:
         with warnings.catch_warnings():  # no rows: said below, not as numpy's warning
             warnings.simplefilter("ignore", UserWarning)
             with path.open(encoding="utf-8-sig") as fh:
                 rows = fh if delimiter == "," else (line.replace(",", ".") for line in fh)
-                data = np.loadtxt(rows, delimiter=delimiter, skiprows=1, ndmin=2, dtype=float)
+                data = np.loadtxt(rows, delimiter=delimiter, skiprows=1 + len(labels), ndmin=2, dtype=float)
     except ValueError as exc:
         raise RecordingError(f"{path}: unreadable number ({exc})") from None
     if data.shape[0] == 0 or data.shape[1] != len(header):
@@ -216,6 +219,9 @@ def _read_csv(path: Path, fs: float | None, max_gap: float, t_scale: float, colu
                     None if "t" not in col else col["t"] * t_scale,
                     columns(MAG_COLUMNS), columns(REF_COLUMNS),
                     None if movement is None else _flag(path, MOVEMENT_COLUMN, movement))
+    if labels:
+        rec.notes.append(f"{rec.name}: {len(labels)} row{'s' * (len(labels) > 1)} after the header without a number "
+                         f"skipped (units?): {' / '.join(labels)}")
     unknown = [c for c in header if c not in KNOWN_COLUMNS]
     if unknown:
         absent = [c for c in KNOWN_COLUMNS if c not in header]
@@ -232,6 +238,28 @@ def _read_csv(path: Path, fs: float | None, max_gap: float, t_scale: float, colu
     if index[-1] + 1 > len(index):
         rec = _fill_gaps(rec, index)
     return rec
+
+
+def _label_rows(path: Path, delimiter: str) -> list[str]:
+    """The rows right after the header (at most MAX_LABEL_ROWS) in which no field is a
+    number: a units row ("s,rad/s,…") or a second header line, as loggers write them."""
+    labels = []
+    with path.open(encoding="utf-8-sig") as fh:
+        next(fh, None)
+        for line in itertools.islice(fh, MAX_LABEL_ROWS + 1):
+            fields = (line if delimiter == "," else line.replace(",", ".")).strip().split(delimiter)
+            if not line.strip() or any(_is_number(f) for f in fields):
+                break
+            labels.append(line.strip())
+    return labels if len(labels) <= MAX_LABEL_ROWS else []
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
 
 
 def _renamed(path: Path, header: list[str], columns: dict) -> list[str]:

@@ -61,7 +61,8 @@ def test_rounded_and_jittering_time_stamps_give_the_rate_of_the_whole_span(tmp_p
 
 def test_a_spreadsheets_header_and_separators_read_as_ours(tmp_path, recording):
     """A byte-order mark and spaces around the names (as spreadsheets export), semicolons
-    with decimal commas (a spreadsheet in a German locale) and tabs change nothing."""
+    with decimal commas (a spreadsheet in a German locale), tabs and a units row under the
+    header (noted) change nothing; four rows without a number are not taken for units."""
     _, gyr, acc, _ = recording
     t = np.arange(1, 101) / FS
     _write(tmp_path / "plain.csv", t, gyr[:100], acc[:100])
@@ -70,6 +71,10 @@ def test_a_spreadsheets_header_and_separators_read_as_ours(tmp_path, recording):
         "sheet.csv": ["\ufeff" + ", ".join(lines[0].split(",")), *lines[1:]],
         "semicolon.csv": [line.replace(",", ";").replace(".", ",") for line in lines],
         "tab.tsv": [line.replace(",", "\t") for line in lines],
+        "units.csv": [lines[0], "s,rad/s,rad/s,rad/s,m/s²,m/s²,m/s²", *lines[1:]],
+        "units_semicolon.csv": [line.replace(",", ";").replace(".", ",") for line in lines[:1]]
+        + ["[s];[rad/s];[rad/s];[rad/s];[m/s²];[m/s²];[m/s²]", "; ; ; ; ; ;"]
+        + [line.replace(",", ";").replace(".", ",") for line in lines[1:]],
     }
     plain = read_recording(tmp_path / "plain.csv")
     for name, sheet_lines in sheets.items():
@@ -77,7 +82,11 @@ def test_a_spreadsheets_header_and_separators_read_as_ours(tmp_path, recording):
         sheet = read_recording(tmp_path / name)
         assert sheet.fs == plain.fs and np.array_equal(sheet.t, plain.t), name
         assert np.array_equal(sheet.gyr, plain.gyr) and np.array_equal(sheet.acc, plain.acc), name
+        assert any("after the header without a number skipped (units?)" in n for n in sheet.notes) == ("units" in name)
     assert "," in sheets["semicolon.csv"][1]  # the decimal commas were there to be read
+    (tmp_path / "labels.csv").write_text("\n".join([lines[0], *["a,b,c,d,e,f,g"] * 4, *lines[1:]]) + "\n")
+    with pytest.raises(RecordingError, match="unreadable number"):
+        read_recording(tmp_path / "labels.csv")
 
 
 def test_columns_it_cannot_use_are_refused_or_named(tmp_path, recording, capsys):
