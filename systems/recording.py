@@ -208,8 +208,8 @@ def _read_csv(path: Path, fs: float | None, max_gap: float, t_scale: float, colu
             with path.open(encoding="utf-8-sig") as fh:
                 rows = fh if delimiter == "," else (line.replace(",", ".") for line in fh)
                 data = np.loadtxt(rows, delimiter=delimiter, skiprows=1 + len(labels), ndmin=2, dtype=float)
-    except ValueError as exc:
-        raise RecordingError(f"{path}: unreadable number ({exc})") from None
+    except ValueError:
+        raise RecordingError(f"{path}: {_first_bad_line(path, delimiter, header, 1 + len(labels))}") from None
     if data.shape[0] == 0 or data.shape[1] != len(header):
         raise RecordingError(f"{path}: expected {len(header)} columns of numbers and at least one row")
     col = {name: data[:, i] for i, name in enumerate(header)}
@@ -252,6 +252,23 @@ def _label_rows(path: Path, delimiter: str) -> list[str]:
                 break
             labels.append(line.strip())
     return labels if len(labels) <= MAX_LABEL_ROWS else []
+
+
+def _first_bad_line(path: Path, delimiter: str, header: list[str], skip: int) -> str:
+    """Where the rows after the first `skip` lines stop being numbers under the header, said
+    with the file's line number and the column's name."""
+    with path.open(encoding="utf-8-sig") as fh:
+        for number, line in enumerate(fh, start=1):
+            text = line.strip()
+            if number <= skip or not text or text.startswith("#"):
+                continue
+            fields = (text if delimiter == "," else text.replace(",", ".")).split(delimiter)
+            if len(fields) != len(header):
+                return f"line {number} has {len(fields)} fields, the header {len(header)}: {text[:80]!r}"
+            for name, field in zip(header, fields):
+                if not _is_number(field):
+                    return f"unreadable number in line {number}, column {name}: {field.strip()[:40]!r}"
+    return "unreadable numbers"
 
 
 def _is_number(text: str) -> bool:

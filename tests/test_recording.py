@@ -62,7 +62,8 @@ def test_rounded_and_jittering_time_stamps_give_the_rate_of_the_whole_span(tmp_p
 def test_a_spreadsheets_header_and_separators_read_as_ours(tmp_path, recording):
     """A byte-order mark and spaces around the names (as spreadsheets export), semicolons
     with decimal commas (a spreadsheet in a German locale), tabs and a units row under the
-    header (noted) change nothing; four rows without a number are not taken for units."""
+    header (noted) change nothing; four rows without a number are not taken for units. A
+    row that is not numbers is refused naming its line and column."""
     _, gyr, acc, _ = recording
     t = np.arange(1, 101) / FS
     _write(tmp_path / "plain.csv", t, gyr[:100], acc[:100])
@@ -85,8 +86,13 @@ def test_a_spreadsheets_header_and_separators_read_as_ours(tmp_path, recording):
         assert any("after the header without a number skipped (units?)" in n for n in sheet.notes) == ("units" in name)
     assert "," in sheets["semicolon.csv"][1]  # the decimal commas were there to be read
     (tmp_path / "labels.csv").write_text("\n".join([lines[0], *["a,b,c,d,e,f,g"] * 4, *lines[1:]]) + "\n")
-    with pytest.raises(RecordingError, match="unreadable number"):
+    with pytest.raises(RecordingError, match="unreadable number in line 2, column t: 'a'"):
         read_recording(tmp_path / "labels.csv")
+    for bad_line, message in ((lines[5].rsplit(",", 1)[0], "line 6 has 6 fields, the header 7"),
+                              (lines[5].rsplit(",", 1)[0] + ",9.8 m/s²", "unreadable number in line 6, column acc_z: '9.8 m/s²'")):
+        (tmp_path / "bad.csv").write_text("\n".join([*lines[:5], bad_line, *lines[6:]]) + "\n", encoding="utf-8")
+        with pytest.raises(RecordingError, match=message):
+            read_recording(tmp_path / "bad.csv")
 
 
 def test_columns_it_cannot_use_are_refused_or_named(tmp_path, recording, capsys):
