@@ -15,8 +15,8 @@ from blocks.methods import METHODS
 from blocks.methods import method as known_method
 from blocks.stages import ESTIMATORS
 
-from .recording import (ACC_UNITS, GYR_UNITS, KNOWN_COLUMNS, MAG_UNITS, MAX_GAP_S, MOVEMENT_COLUMN, REF_COLUMNS,
-                        T_UNITS)
+from .recording import (ACC_UNITS, GYR_UNITS, KNOWN_COLUMNS, MAG_UNITS, MAT_VARIABLES, MAX_GAP_S, MOVEMENT_COLUMN,
+                        REF_COLUMNS, T_UNITS)
 
 EXIT_BAD_INPUT = 2
 EXIT_CHECK_FAILED = 1
@@ -38,8 +38,9 @@ def _column(text: str) -> tuple[str, str]:
     name, sep, header = text.partition("=")
     if not sep or not header.strip():
         raise argparse.ArgumentTypeError(f"expected NAME=HEADER (e.g. gyr_x=Gyr_X), got {text!r}")
-    if name.strip() not in KNOWN_COLUMNS:
-        raise argparse.ArgumentTypeError(f"{name!r} is not a column read; NAME is one of {', '.join(KNOWN_COLUMNS)}")
+    if name.strip() not in KNOWN_COLUMNS + MAT_VARIABLES:
+        raise argparse.ArgumentTypeError(f"{name!r} is not a column read; NAME is one of {', '.join(KNOWN_COLUMNS)} "
+                                         f"(a CSV) or {', '.join(MAT_VARIABLES)} (a .mat)")
     return name.strip(), header.strip()
 
 
@@ -84,7 +85,8 @@ def _add_input_flags(parser) -> None:
     parser.add_argument("--t-unit", default="s", choices=list(T_UNITS), help="unit of a CSV's t column (default s)")
     parser.add_argument("--column", type=_column, action="append", default=[], metavar="NAME=HEADER",
                         help="read the CSV's column HEADER as NAME (t, gyr_x, acc_x, mag_x, ref_q_w, movement, ...), "
-                             "for a header with other names; repeatable")
+                             "or a .mat's variable HEADER as NAME (imu_gyr, imu_acc, imu_mag, opt_quat, movement, "
+                             "sampling_rate), for a file with other names; repeatable")
     for sensor, what in (("gyr", "gyro"), ("acc", "accelerometer"), ("mag", "magnetometer")):
         parser.add_argument(f"--{sensor}-axes", type=_axes, metavar="MAP",
                             help=f"the {what}'s axes as the file's, signed: y,x,-z takes x from the file's y, y from "

@@ -23,6 +23,7 @@ MAG_COLUMNS = ("mag_x", "mag_y", "mag_z")
 REF_COLUMNS = ("ref_q_w", "ref_q_x", "ref_q_y", "ref_q_z")  # optional reference orientation, sensor → earth
 MOVEMENT_COLUMN = "movement"  # optional: 1 in the phase the errors are measured over, else 0
 KNOWN_COLUMNS = ("t", *IMU_COLUMNS, *MAG_COLUMNS, *REF_COLUMNS, MOVEMENT_COLUMN)  # the names a CSV's header may use
+MAT_VARIABLES = ("imu_gyr", "imu_acc", "imu_mag", "opt_quat", "movement", "sampling_rate")  # a .mat's (BROAD's)
 OUTPUT_COLUMNS = ("t", "q_w", "q_x", "q_y", "q_z", "g_x", "g_y", "g_z")
 EULER_COLUMNS = ("roll_deg", "pitch_deg", "yaw_deg")  # with --euler
 GYR_UNITS = {"rad/s": 1.0, "deg/s": math.pi / 180.0, "mdeg/s": math.pi / 180e3}
@@ -123,18 +124,16 @@ def read_recording(path, fs: float | None = None, gyr_unit: str = "rad/s", acc_u
     maps = {name: parse_axes(text) for name, text in (("gyr", gyr_axes), ("acc", acc_axes), ("mag", mag_axes))
             if text is not None}
     columns = dict(columns or {})
-    unknown = [name for name in columns if name not in KNOWN_COLUMNS]
+    mat = path.suffix.lower() == ".mat"
+    known = MAT_VARIABLES if mat else KNOWN_COLUMNS
+    unknown = [name for name in columns if name not in known]
     if unknown:
-        raise RecordingError(f"--column names {', '.join(unknown)}; the columns read are {', '.join(KNOWN_COLUMNS)}")
+        raise RecordingError(f"--column names {', '.join(unknown)}; a {'.mat' if mat else 'CSV'}'s names read are "
+                             f"{', '.join(known)}")
     shared = sorted({c for c in columns.values() if list(columns.values()).count(c) > 1})
     if shared:
         raise RecordingError(f"--column gives the file's column {', '.join(shared)} more than one name")
-    if path.suffix.lower() == ".mat":
-        if columns:
-            raise RecordingError(f"{path}: --column renames a CSV's columns; a .mat has BROAD's variables")
-        rec = _read_mat(path, fs)
-    else:
-        rec = _read_csv(path, fs, max_gap, T_UNITS[t_unit], columns)
+    rec = _read_mat(path, fs, columns) if mat else _read_csv(path, fs, max_gap, T_UNITS[t_unit], columns)
     if fs is not None and abs(rec.fs - fs) > 0.01 * fs:
         raise RecordingError(f"{path}: --fs {fs:g} Hz disagrees with the recording's {rec.fs:g} Hz")
     rec.gyr = rec.gyr * GYR_UNITS[gyr_unit]
@@ -375,8 +374,9 @@ def _flag(path: Path, name: str, values) -> np.ndarray:
     return values == 1
 
 
-def _read_mat(path: Path, fs: float | None) -> Recording:
-    """A BROAD recording; without a sampling_rate variable, at fs (Hz) if given."""
+def _read_mat(path: Path, fs: float | None, columns: dict) -> Recording:
+    """A BROAD recording, its variables (MAT_VARIABLES) renamed from the file's by columns
+    ({BROAD's name: the file's}); without a sampling_rate variable, at fs (Hz) if given."""
     from scipy.io import loadmat
 
     try:
@@ -385,10 +385,16 @@ def _read_mat(path: Path, fs: float | None) -> Recording:
         mat = _read_mat_v73(path)
     except Exception as exc:  # scipy raises several types for damaged files
         raise RecordingError(f"{path}: not a readable MATLAB file ({exc})") from None
+    variables = ", ".join(k for k in mat if not k.startswith("__")) or "none"
+    absent = [theirs for theirs in columns.values() if theirs not in mat]
+    if absent:
+        raise RecordingError(f"{path}: --column names {', '.join(absent)}, not a variable of the file ({variables})")
+    mat = {**{k: v for k, v in mat.items() if k not in columns}, **{ours: mat[theirs] for ours, theirs in columns.items()}}
     missing = [k for k in ("imu_gyr", "imu_acc", *(() if fs else ("sampling_rate",))) if k not in mat]
     if missing:
         raise RecordingError(f"{path}: missing variables {', '.join(missing)} (expected a BROAD recording"
-                             f"{'; without sampling_rate give --fs HZ' if 'sampling_rate' in missing else ''})")
+                             f"{'; without sampling_rate give --fs HZ' if 'sampling_rate' in missing else ''}; "
+                             f"the file has {variables}: name them with --column, e.g. --column imu_gyr=NAME)")
     try:
         fs = float(mat["sampling_rate"]) if "sampling_rate" in mat else fs
     except (TypeError, ValueError):

@@ -123,8 +123,9 @@ def test_a_loggers_header_is_read_through_column_names(tmp_path, recording, caps
     --column flags that read it, and read with them gives our CSV's estimate; so does a
     header marked as a comment with spaces in its names and t in ns (EuRoC-style). A
     column of the file that has a name given to another is left unread and noted;
-    a name given twice, a header name not in the file, one given two names, a name not
-    read and --column on a .mat are refused."""
+    a name given twice, a header name not in the file, one given two names and a name
+    not read are refused. A .mat of one's own is refused naming its variables, and read
+    with them named for BROAD's."""
     _, gyr, acc, _ = recording
     n = 1000
     t = np.arange(1, n + 1) / FS
@@ -167,10 +168,18 @@ def test_a_loggers_header_is_read_through_column_names(tmp_path, recording, caps
         assert main(["estimate", str(tmp_path / "in.csv"), "--out", str(out), *flags_given]) == 2
         assert message in capsys.readouterr().err, message
     assert main(["estimate", str(tmp_path / "in.mat"), "--out", str(out), "--column", "t=time"]) == 2
-    assert "--column renames a CSV's columns; a .mat has BROAD's variables" in capsys.readouterr().err
+    assert "--column names t; a .mat's names read are imu_gyr, imu_acc" in capsys.readouterr().err
     with pytest.raises(SystemExit):
         main(["estimate", str(tmp_path / "in.csv"), "--out", str(out), "--column", "gyro_x=time"])
     assert "'gyro_x' is not a column read" in capsys.readouterr().err
+    # a .mat of one's own: its variables named for BROAD's, as the message says
+    savemat(tmp_path / "own.mat", {"gyro": gyr[:n], "accel": acc[:n], "rate": FS})
+    assert main(["estimate", str(tmp_path / "own.mat"), "--out", str(out)]) == 2
+    assert ("missing variables imu_gyr, imu_acc, sampling_rate (expected a BROAD recording; without sampling_rate "
+            "give --fs HZ; the file has gyro, accel, rate: name them with --column") in capsys.readouterr().err
+    assert main(["estimate", str(tmp_path / "own.mat"), "--out", str(out), "--column", "imu_gyr=gyro",
+                 "--column", "imu_acc=accel", "--column", "sampling_rate=rate"]) == 0
+    assert np.array_equal(np.loadtxt(out, delimiter=",", skiprows=1)[:, 1:], ours[:, 1:])
 
 
 def test_a_sensor_held_at_its_range_is_noted(tmp_path):
