@@ -82,7 +82,8 @@ def _window_means(frames: Rotation, vectors, finite, window: int):
         used = finite[rows].reshape(-1, window)[:, :, None]
         q = frames[rows].as_matrix().reshape(-1, window, 3, 3) * used[..., None]
         mean_frame[b] = q.sum(axis=1) / count[b, None, None]
-        products[b] = np.einsum("bwki,bwj->bkij", q, (vectors[rows].reshape(-1, window, 3) * used)) / count[b, None, None, None]
+        v = vectors[rows].reshape(-1, window, 3) * used
+        products[b] = np.einsum("bwki,bwj->bkij", q, v) / count[b, None, None, None]
     return mean_frame, products
 
 
@@ -134,11 +135,12 @@ def axes_note(name: str, what: str, flag: str, unit: str, scores: dict | None, m
     head = (f"{name}: {what} does not turn as the gyro says (mean-square change of its {WINDOW_S:g}-s means "
             f"in the gyro's frame {given:.3g} ({unit})²")
     if runner_up < MISMATCH_RATIO * best:
-        return f"{head}, {best:.3g} with other axes, which this motion does not single out); check {flag} and --gyr-axes"
+        return (f"{head}, {best:.3g} with other axes, which this motion does not single out); "
+                f"check {flag} and --gyr-axes")
     index, reversed_gyro = ranked[0]
-    flags = " ".join(([f"{flag} {axes_text(MAPS[index])}"] if index else [])
-                     + (["--gyr-axes -x,-y,-z"] if reversed_gyro else []))
-    negative = (f"; {flag} {axes_text(-MAPS[index])}, the same with the sign of {what} reversed, fits as well"
+    flags = " ".join(([f"{flag}={axes_text(MAPS[index])}"] if index else [])
+                     + (["--gyr-axes=-x,-y,-z"] if reversed_gyro else []))  # "=": a map may begin with "-"
+    negative = (f"; {flag}={axes_text(-MAPS[index])}, the same with the sign of {what} reversed, fits as well"
                 if index else "")
     return f"{head}); with {flags} it is {best:.3g}: pass that if the file's axes are so{negative}"
 

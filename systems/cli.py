@@ -90,8 +90,9 @@ def _add_input_flags(parser) -> None:
     for sensor, what in (("gyr", "gyro"), ("acc", "accelerometer"), ("mag", "magnetometer")):
         parser.add_argument(f"--{sensor}-axes", type=_axes, metavar="MAP",
                             help=f"the {what}'s axes as the file's, signed: y,x,-z takes x from the file's y, y from "
-                                 "its x and z from its −z (default x,y,z); a sensor that does not turn as the gyro "
-                                 "says is noted with the maps that fit")
+                                 "its x and z from its −z (default x,y,z; one that begins with a minus as "
+                                 f"--{sensor}-axes=-x,y,z); a sensor that does not turn as the gyro says is noted "
+                                 "with the maps that fit")
     parser.add_argument("--max-gap", type=float, default=MAX_GAP_S, metavar="S",
                         help="longest run of samples missing from a CSV's time stamps, or of gyro or "
                              "accelerometer values that are not finite, that is filled in (interpolated "

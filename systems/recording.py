@@ -389,7 +389,8 @@ def _read_mat(path: Path, fs: float | None, columns: dict) -> Recording:
     absent = [theirs for theirs in columns.values() if theirs not in mat]
     if absent:
         raise RecordingError(f"{path}: --column names {', '.join(absent)}, not a variable of the file ({variables})")
-    mat = {**{k: v for k, v in mat.items() if k not in columns}, **{ours: mat[theirs] for ours, theirs in columns.items()}}
+    mat = {**{k: v for k, v in mat.items() if k not in columns},
+           **{ours: mat[theirs] for ours, theirs in columns.items()}}
     missing = [k for k in ("imu_gyr", "imu_acc", *(() if fs else ("sampling_rate",))) if k not in mat]
     if missing:
         raise RecordingError(f"{path}: missing variables {', '.join(missing)} (expected a BROAD recording"

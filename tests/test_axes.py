@@ -55,7 +55,7 @@ def test_sensors_on_other_axes_are_named_and_their_maps_give_the_estimate_back(t
     """An accelerometer on other axes than the gyro (y,-x,z read as x,y,z) and an MPU-9250's
     magnetometer (x and y swapped, z reversed) are each noted with the flag that maps them
     back, and with those flags the estimate is the recording's in its own axes to 1e-12;
-    a gyro turning the other way is noted with --gyr-axes -x,-y,-z. The recording in its
+    a gyro turning the other way is noted with --gyr-axes=-x,-y,-z. The recording in its
     own axes gets no such note."""
     t, gyr, acc, mag = human
     _write(tmp_path / "true.csv", t, gyr, acc, mag)
@@ -64,15 +64,18 @@ def test_sensors_on_other_axes_are_named_and_their_maps_give_the_estimate_back(t
     acc_file, mag_file = acc @ parse_axes("y,-x,z"), mag @ parse_axes("y,x,-z")  # file = P⁻¹·true: P maps back
     _write(tmp_path / "swapped.csv", t, gyr, acc_file, mag_file)
     _, err = _estimate(tmp_path, capsys, "swapped")
-    assert "the accelerometer does not turn as the gyro says" in err and "with --acc-axes y,-x,z it is" in err, err
-    assert "the magnetometer does not turn as the gyro says" in err and "with --mag-axes y,x,-z it is" in err, err
-    assert "--acc-axes -y,x,-z, the same with the sign of the accelerometer reversed, fits as well" in err
-    mapped, err = _estimate(tmp_path, capsys, "swapped", "--acc-axes", "y,-x,z", "--mag-axes", "y,x,-z")
+    assert "the accelerometer does not turn as the gyro says" in err and "with --acc-axes=y,-x,z it is" in err, err
+    assert "the magnetometer does not turn as the gyro says" in err and "with --mag-axes=y,x,-z it is" in err, err
+    assert "--acc-axes=-y,x,-z, the same with the sign of the accelerometer reversed, fits as well" in err
+    named = [flag for note in err.splitlines() if " it is " in note
+             for flag in note.split("with ")[1].split(" it is")[0].split()]
+    assert named == ["--acc-axes=y,-x,z", "--mag-axes=y,x,-z"], named  # passed below as the notes write them
+    mapped, err = _estimate(tmp_path, capsys, "swapped", *named)
     assert "does not turn" not in err, err
     assert np.abs(mapped - truth).max() < 1e-12
     _write(tmp_path / "reversed.csv", t, -gyr, acc, mag)
     _, err = _estimate(tmp_path, capsys, "reversed")
-    assert "with --gyr-axes -x,-y,-z it is" in err, err
+    assert "with --gyr-axes=-x,-y,-z it is" in err, err
     assert np.abs(_estimate(tmp_path, capsys, "reversed", "--gyr-axes=-x,-y,-z")[0] - truth).max() < 1e-12
 
 

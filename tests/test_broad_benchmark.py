@@ -122,4 +122,4 @@ def test_the_recordings_axes_pass_the_axis_check_and_a_swapped_magnetometer_is_n
         assert not [n for n in rec.notes if "does not turn" in n], rec.name
         notes = axes_notes(rec.name, rec.gyr, rec.acc, rec.mag @ parse_axes("y,x,-z"), rec.fs)
         turning = any(kind in rec.name for kind in ("rotation", "combined", "tapping", "vibration", "stationary"))
-        assert len(notes) == turning and all("--mag-axes y,x,-z" in n for n in notes), (rec.name, notes)
+        assert len(notes) == turning and all("--mag-axes=y,x,-z" in n for n in notes), (rec.name, notes)

@@ -82,9 +82,10 @@ def test_euler_adds_the_angles_of_the_fmus_outputs(tmp_path, imu):
 def test_offsets_add_the_gyro_offset_and_hard_iron_estimates_that_find_the_sensors(tmp_path):
     """--offsets appends the gyro-offset and hard-iron estimates after each sample, the
     batch path's (and the FMU's outputs of those names); on 120 s of human motion from a
-    gyro (1, −0.6, 0.4) °/s off and a magnetometer with (15, −10, 5) µT of hard iron they end within
-    0.1 °/s (tracked in motion alone: the motion never rests) and 0.5 µT of the truth. With --gyro-offset off the gyro columns are 0;
-    without a magnetometer there are no hard-iron columns."""
+    gyro (1, −0.6, 0.4) °/s off and a magnetometer with (15, −10, 5) µT of hard iron they
+    end within 0.1 °/s (tracked in motion alone: the motion never rests) and 0.5 µT of the
+    truth. With --gyro-offset off the gyro columns are 0; without a magnetometer there are
+    no hard-iron columns."""
     motion = HumanMotion(delta_v=0.1, omega_c=5.0).generate(120.0, FS, seed=11)
     truth_gyr, truth_mag = np.radians([1.0, -0.6, 0.4]), np.array([15.0, -10.0, 5.0])
     sensor = ImuModel(delta_n=math.radians(0.05), gyr_offset=tuple(truth_gyr), mag_noise=0.2,

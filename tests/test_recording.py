@@ -89,7 +89,8 @@ def test_a_spreadsheets_header_and_separators_read_as_ours(tmp_path, recording):
     with pytest.raises(RecordingError, match="unreadable number in line 2, column t: 'a'"):
         read_recording(tmp_path / "labels.csv")
     for bad_line, message in ((lines[5].rsplit(",", 1)[0], "line 6 has 6 fields, the header 7"),
-                              (lines[5].rsplit(",", 1)[0] + ",9.8 m/s²", "unreadable number in line 6, column acc_z: '9.8 m/s²'")):
+                              (lines[5].rsplit(",", 1)[0] + ",9.8 m/s²",
+                               "unreadable number in line 6, column acc_z: '9.8 m/s²'")):
         (tmp_path / "bad.csv").write_text("\n".join([*lines[:5], bad_line, *lines[6:]]) + "\n", encoding="utf-8")
         with pytest.raises(RecordingError, match=message):
             read_recording(tmp_path / "bad.csv")
@@ -203,8 +204,8 @@ def test_a_sensor_held_at_its_range_is_noted(tmp_path):
     swing = sine_rotation(amplitude_deg=90.0, frequency=1.0).generate(30.0, 1000.0)
     assert np.abs(swing.gyr).max() > math.radians(560.0)
     turntable = steady_lever_arm(rate=3.0).generate(60.0, FS)
-    started = ClosedFormMotion("started", lambda t: Rotation.from_rotvec(np.outer(3.0 * np.maximum(t - 40.0, 0.0), [0, 0, 1])),
-                               lambda t: np.zeros((len(t), 3))).generate(60.0, FS)
+    turned = lambda t: Rotation.from_rotvec(np.outer(3.0 * np.maximum(t - 40.0, 0.0), [0, 0, 1]))
+    started = ClosedFormMotion("started", turned, lambda t: np.zeros((len(t), 3))).generate(60.0, FS)
     gyr_limit = math.radians(125.0)
     cases = [  # (name, (gyr, acc), the note, rate)
         ("gyro", (np.clip(human[0], -gyr_limit, gyr_limit), human[1]),
