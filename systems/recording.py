@@ -230,6 +230,9 @@ def _read_csv(path: Path, fs: float | None, max_gap: float, t_scale: float, colu
         return rec
     if not np.isfinite(rec.t).all():
         raise RecordingError(f"{path}: column t has non-finite values")
+    if len(rec.t) == 1 and fs is not None:  # one time stamp gives no rate; --fs does
+        rec.fs = float(fs)
+        return rec
     index, rec.fs, off_grid = _sample_grid(path, rec.t, max_gap)
     if off_grid > JITTER_NOTE:
         rec.notes.append(f"{rec.name}: time stamps up to {off_grid:.0%} of a step off a uniform grid; "

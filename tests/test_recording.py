@@ -293,6 +293,18 @@ def test_time_stamps_in_milliseconds_need_their_unit(tmp_path, recording, capsys
     assert np.allclose(milliseconds, seconds, rtol=0, atol=1e-9)
 
 
+def test_one_time_stamp_reads_at_the_rate_given(tmp_path, capsys):
+    """A CSV of one row has no step to take the rate from: refused with the hint, and read
+    at --fs, its time stamp kept, with it."""
+    (tmp_path / "in.csv").write_text("t," + ",".join(IMU_COLUMNS) + "\n0.5,0.01,0,0,0,0,9.8\n")
+    with pytest.raises(RecordingError, match="one sample cannot give a sample rate; give --fs HZ"):
+        read_recording(tmp_path / "in.csv")
+    rec = read_recording(tmp_path / "in.csv", fs=FS)
+    assert rec.fs == FS and np.array_equal(rec.t, [0.5])
+    data, _ = _estimate_csv(tmp_path, capsys, "--fs", str(FS))
+    assert data.shape == (8,) and data[0] == 0.5 and np.allclose(data[5:8], [0.0, 0.0, 1.0])
+
+
 def _kept_rows(n, seed, runs):
     """(n, bool) rows a logger kept: False in `runs` dropouts of 1–29 rows from a fixed seed."""
     rng = np.random.default_rng(seed)
