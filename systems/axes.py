@@ -68,6 +68,11 @@ def _orientations(gyr, fs: float) -> Rotation:
     return Rotation.from_quat(quat, scalar_first=True)
 
 
+def _window(fs: float) -> int:
+    """Samples in a window of WINDOW_S seconds at fs (Hz)."""
+    return max(1, int(round(WINDOW_S * fs)))
+
+
 def _window_means(frames: Rotation, vectors, finite, window: int):
     """Per window of `window` samples, over its finite rows: the mean frame matrix Q (B×3×3)
     and the means of Q_ki·v_j (B×3×3×3), a map P's mean in the gyro frame being
@@ -87,13 +92,14 @@ def _window_means(frames: Rotation, vectors, finite, window: int):
     return mean_frame, products
 
 
-def mismatches(gyr, vectors, fs: float, hard_iron: bool = False) -> dict | None:
+def mismatches(frames: dict, vectors, fs: float, hard_iron: bool = False) -> dict | None:
     """{(map index in MAPS, gyro reversed): mean-square mismatch} (units² of vectors) of
-    every map of vectors (N×3; rows with a NaN are not used), with the gyro (N×3, rad/s)
+    every map of vectors (N×3; rows with a NaN are not used), in frames ({gyro reversed:
+    the N frames _orientations integrates from the gyro, or from its negative}): the gyro
     as it is and, unless hard_iron (the magnetometer: its offset is fitted per map),
     reversed; None where fewer than MIN_WINDOWS pairs of windows turn enough."""
-    window = max(1, int(round(WINDOW_S * fs)))
-    blocks = len(gyr) // window
+    window = _window(fs)
+    blocks = len(vectors) // window
     if blocks < MIN_WINDOWS:
         return None
     n = blocks * window
@@ -102,13 +108,13 @@ def mismatches(gyr, vectors, fs: float, hard_iron: bool = False) -> dict | None:
     sampled = finite.reshape(blocks, window).any(axis=1)
     scores = {}
     for reversed_gyro in (False, True) if not hard_iron else (False,):
-        frames = _orientations(-gyr[:n] if reversed_gyro else gyr[:n], fs)
-        centres = frames[window // 2::window]
+        turned = frames[reversed_gyro][:n]
+        centres = turned[window // 2::window]
         turn = (centres[:-1].inv() * centres[1:]).magnitude()
         pairs = np.flatnonzero((turn >= MIN_TURN_RAD) & sampled[:-1] & sampled[1:])
         if len(pairs) < MIN_WINDOWS:
             return None
-        mean_frame, products = _window_means(frames, vectors, finite, window)
+        mean_frame, products = _window_means(turned, vectors, finite, window)
         lever = -(mean_frame[pairs + 1] - mean_frame[pairs])  # −Δ mean(Q)·h: the hard iron's part
         for index, matrix in enumerate(MAPS):
             means = np.einsum("bkij,ij->bk", products, matrix)
@@ -147,9 +153,12 @@ def axes_note(name: str, what: str, flag: str, unit: str, scores: dict | None, m
 
 def axes_notes(name: str, gyr, acc, mag, fs: float) -> list[str]:
     """The notes of axes_note on a recording's accelerometer and magnetometer (or None)."""
+    if len(gyr) // _window(fs) < MIN_WINDOWS:  # too short for a verdict (mismatches): nothing integrated
+        return []
+    frames = {False: _orientations(gyr, fs), True: _orientations(-gyr, fs)}  # one integration each, for both sensors
     mean_square = lambda v: float(np.nanmean(np.sum(v**2, axis=1)))
-    notes = [axes_note(name, "the accelerometer", "--acc-axes", "m/s²", mismatches(gyr, acc, fs), mean_square(acc))]
+    notes = [axes_note(name, "the accelerometer", "--acc-axes", "m/s²", mismatches(frames, acc, fs), mean_square(acc))]
     if mag is not None:
-        notes.append(axes_note(name, "the magnetometer", "--mag-axes", "µT", mismatches(gyr, mag, fs, hard_iron=True),
-                               mean_square(mag)))
+        notes.append(axes_note(name, "the magnetometer", "--mag-axes", "µT",
+                               mismatches(frames, mag, fs, hard_iron=True), mean_square(mag)))
     return [note for note in notes if note]

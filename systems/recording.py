@@ -182,6 +182,7 @@ def field_norm_note(rec: Recording) -> str | None:
 def _read_csv(path: Path, fs: float | None, max_gap: float, t_scale: float, columns: dict) -> Recording:
     with path.open(newline="", encoding="utf-8-sig") as fh:  # a spreadsheet's byte-order mark is not a name
         first = fh.readline()
+        following = list(itertools.islice(fh, MAX_LABEL_ROWS + 1))
     delimiter = max(DELIMITERS, key=first.count)
     header = next(csv.reader([first], delimiter=delimiter), None)
     if not header:
@@ -200,12 +201,12 @@ def _read_csv(path: Path, fs: float | None, max_gap: float, t_scale: float, colu
                                  f"the header has only {','.join(given)}")
     if "t" not in header and fs is None:
         raise RecordingError(f"{path}: no 't' column; give the sample rate with --fs HZ{_column_hint(['t'], header)}")
-    labels = _label_rows(path, delimiter)
+    labels = _label_rows(following, delimiter)
     try:
         with warnings.catch_warnings():  # no rows: said below, not as numpy's warning
             warnings.simplefilter("ignore", UserWarning)
             with path.open(encoding="utf-8-sig") as fh:
-                rows = fh if delimiter == "," else (line.replace(",", ".") for line in fh)
+                rows = fh if delimiter == "," else (_decimal_points(line, delimiter) for line in fh)
                 data = np.loadtxt(rows, delimiter=delimiter, skiprows=1 + len(labels), ndmin=2, dtype=float)
     except ValueError:
         raise RecordingError(f"{path}: {_first_bad_line(path, delimiter, header, 1 + len(labels))}") from None
@@ -242,17 +243,21 @@ def _read_csv(path: Path, fs: float | None, max_gap: float, t_scale: float, colu
     return rec
 
 
-def _label_rows(path: Path, delimiter: str) -> list[str]:
-    """The rows right after the header (at most MAX_LABEL_ROWS) in which no field is a
-    number: a units row ("s,rad/s,…") or a second header line, as loggers write them."""
+def _decimal_points(line: str, delimiter: str) -> str:
+    """line with its decimal commas as points, where the separator is not the comma."""
+    return line if delimiter == "," else line.replace(",", ".")
+
+
+def _label_rows(lines, delimiter: str) -> list[str]:
+    """Of the lines right after the header, the first ones (at most MAX_LABEL_ROWS) in
+    which no field is a number: a units row ("s,rad/s,…") or a second header line, as
+    loggers write them."""
     labels = []
-    with path.open(encoding="utf-8-sig") as fh:
-        next(fh, None)
-        for line in itertools.islice(fh, MAX_LABEL_ROWS + 1):
-            fields = (line if delimiter == "," else line.replace(",", ".")).strip().split(delimiter)
-            if not line.strip() or any(_is_number(f) for f in fields):
-                break
-            labels.append(line.strip())
+    for line in lines:
+        fields = _decimal_points(line, delimiter).strip().split(delimiter)
+        if not line.strip() or any(_is_number(f) for f in fields):
+            break
+        labels.append(line.strip())
     return labels if len(labels) <= MAX_LABEL_ROWS else []
 
 
@@ -264,7 +269,7 @@ def _first_bad_line(path: Path, delimiter: str, header: list[str], skip: int) ->
             text = line.strip()
             if number <= skip or not text or text.startswith("#"):
                 continue
-            fields = (text if delimiter == "," else text.replace(",", ".")).split(delimiter)
+            fields = _decimal_points(text, delimiter).split(delimiter)
             if len(fields) != len(header):
                 return f"line {number} has {len(fields)} fields, the header {len(header)}: {text[:80]!r}"
             for name, field in zip(header, fields):
