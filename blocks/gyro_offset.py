@@ -44,7 +44,7 @@ import numpy as np
 
 from .jit import kernel
 from .methods import Param, resolve_params
-from .quaternion import quat_multiply, quat_normalized, quat_rotate, rotvec_quat
+from .quaternion import quat_matrix, quat_multiply, quat_normalized, rotvec_quat
 from .sensor_frame import time_reversed
 from .stepper_system import sample_system
 from .wiener_local import butterworth_zoh
@@ -129,37 +129,87 @@ def lowpass_step(rows, j, x, Ad, Bd):
 
 
 @kernel(inline=True)
-def across(v, u, n2):
-    """v minus its component along u (|u|² = n2)."""
-    dot = (v[0] * u[0] + v[1] * u[1] + v[2] * u[2]) / n2
-    return np.array([v[0] - dot * u[0], v[1] - dot * u[1], v[2] - dot * u[2]])
+def scalar_update(b, P, h, z, w):
+    """Kalman update of the offset b (P its covariance, both in place) from one scalar
+    measurement z of h·b with noise variance w."""
+    Ph = (P[0, 0] * h[0] + P[0, 1] * h[1] + P[0, 2] * h[2],
+          P[1, 0] * h[0] + P[1, 1] * h[1] + P[1, 2] * h[2],
+          P[2, 0] * h[0] + P[2, 1] * h[1] + P[2, 2] * h[2])
+    inv_s = 1.0 / (h[0] * Ph[0] + h[1] * Ph[1] + h[2] * Ph[2] + w)
+    innovation = (z - h[0] * b[0] - h[1] * b[1] - h[2] * b[2]) * inv_s
+    for i in range(3):
+        b[i] += Ph[i] * innovation
+        for j in range(3):
+            P[i, j] -= Ph[i] * Ph[j] * inv_s
+
+
+@kernel(inline=True)
+def plane_basis(n):
+    """Two orthonormal vectors across the unit vector n."""
+    # the axis least along n, crossed with n
+    if abs(n[0]) <= abs(n[1]) and abs(n[0]) <= abs(n[2]):
+        e = (0.0, n[2], -n[1])
+    elif abs(n[1]) <= abs(n[2]):
+        e = (-n[2], 0.0, n[0])
+    else:
+        e = (n[1], -n[0], 0.0)
+    norm = math.sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2])
+    e1 = (e[0] / norm, e[1] / norm, e[2] / norm)
+    return e1, (n[1] * e1[2] - n[2] * e1[1], n[2] * e1[0] - n[0] * e1[2], n[0] * e1[1] - n[1] * e1[0])
 
 
 @kernel(inline=True)
 def motion_update(b, P, old, new, r_lp, rb_lp, Ts, W, clip):
     """Kalman update of the offset b (P its covariance) from the turn of the low-passed
-    accelerometer from old to new (gyro frame); r_lp, rb_lp: LP(R) (row-major) and LP(R·b)."""
+    accelerometer from old to new (gyro frame); r_lp, rb_lp: LP(R) (row-major) and LP(R·b).
+
+    The turn rate plus Π·LP(R·b̂) measures H·b, H = Π·LP(R) (the low-pass delays the turn
+    after a change of b̂); the innovation is clipped per component. H has rank 2 at most
+    (Π projects across gravity): its singular directions are those of the 2×2 problem in
+    a basis (e1, e2) across gravity, in closed form. Only directions H keeps
+    at least OBSERVED of are used, each as a scalar measurement u·e of (Hᵀu)·b with
+    variance W (u orthonormal: the joint update, taken one direction at a time)."""
     n2 = new[0] * new[0] + new[1] * new[1] + new[2] * new[2]
     if n2 == 0.0:
         return
-    H = np.empty((3, 3))
-    for j in range(3):
-        H[:, j] = across((r_lp[j], r_lp[3 + j], r_lp[6 + j]), new, n2)
-    # the turn rate plus Π·LP(R·b̂) measures H·b (the low-pass delays the turn after a
-    # change of b̂); clipped innovation
+    norm = math.sqrt(n2)
+    n = (new[0] / norm, new[1] / norm, new[2] / norm)
+    e1, e2 = plane_basis(n)
+    b0 = (b[0], b[1], b[2])
     s = 1.0 / (n2 * Ts)
-    turn = np.array([old[1] * new[2] - old[2] * new[1], old[2] * new[0] - old[0] * new[2],
-                     old[0] * new[1] - old[1] * new[0]]) * s
-    e = np.minimum(np.maximum(turn + across(rb_lp, new, n2) - H @ b, -clip), clip)
-    # only the directions H keeps at least half of
-    U, sv, Vt = np.linalg.svd(H)
-    kept = (sv >= OBSERVED).astype(np.float64)
-    Uk = U * kept
-    Hk = (Uk * sv) @ Vt
-    PHt = P @ Hk.T
-    K = PHt @ np.linalg.inv(Hk @ PHt + W * np.eye(3))
-    b += K @ (Uk @ (Uk.T @ e))
-    P -= K @ Hk @ P
+    turn = ((old[1] * new[2] - old[2] * new[1]) * s, (old[2] * new[0] - old[0] * new[2]) * s,
+            (old[0] * new[1] - old[1] * new[0]) * s)
+    Lb = (r_lp[0] * b[0] + r_lp[1] * b[1] + r_lp[2] * b[2], r_lp[3] * b[0] + r_lp[4] * b[1] + r_lp[5] * b[2],
+          r_lp[6] * b[0] + r_lp[7] * b[1] + r_lp[8] * b[2])
+    along = (rb_lp[0] - Lb[0]) * n[0] + (rb_lp[1] - Lb[1]) * n[1] + (rb_lp[2] - Lb[2]) * n[2]
+    e = (min(max(turn[0] + rb_lp[0] - Lb[0] - along * n[0], -clip), clip),
+         min(max(turn[1] + rb_lp[1] - Lb[1] - along * n[1], -clip), clip),
+         min(max(turn[2] + rb_lp[2] - Lb[2] - along * n[2], -clip), clip))
+    # M = (e1, e2)ᵀ·LP(R), 2×3; the eigenvectors of M·Mᵀ are H's left singular directions
+    m1 = (e1[0] * r_lp[0] + e1[1] * r_lp[3] + e1[2] * r_lp[6], e1[0] * r_lp[1] + e1[1] * r_lp[4] + e1[2] * r_lp[7],
+          e1[0] * r_lp[2] + e1[1] * r_lp[5] + e1[2] * r_lp[8])
+    m2 = (e2[0] * r_lp[0] + e2[1] * r_lp[3] + e2[2] * r_lp[6], e2[0] * r_lp[1] + e2[1] * r_lp[4] + e2[2] * r_lp[7],
+          e2[0] * r_lp[2] + e2[1] * r_lp[5] + e2[2] * r_lp[8])
+    p11 = m1[0] * m1[0] + m1[1] * m1[1] + m1[2] * m1[2]
+    p12 = m1[0] * m2[0] + m1[1] * m2[1] + m1[2] * m2[2]
+    p22 = m2[0] * m2[0] + m2[1] * m2[1] + m2[2] * m2[2]
+    half, mean = 0.5 * (p11 - p22), 0.5 * (p11 + p22)
+    radius = math.sqrt(half * half + p12 * p12)
+    # M·Mᵀ's eigenvalues mean ± radius are H's squared singular values; the eigenvector of
+    # the larger, in its well-conditioned form
+    c, sn = (half + radius, p12) if half >= 0.0 else (p12, radius - half)
+    length = math.sqrt(c * c + sn * sn)
+    c, sn = (c / length, sn / length) if length > 0.0 else (1.0, 0.0)
+    for a in range(2):
+        if a == 1:
+            c, sn = -sn, c
+        if mean + (radius if a == 0 else -radius) < OBSERVED * OBSERVED:
+            continue
+        u = (c * e1[0] + sn * e2[0], c * e1[1] + sn * e2[1], c * e1[2] + sn * e2[2])
+        h = (c * m1[0] + sn * m2[0], c * m1[1] + sn * m2[1], c * m1[2] + sn * m2[2])  # Hᵀ·u
+        # u·e measures h·b at the b the innovation was taken at; later directions see the update
+        z = u[0] * e[0] + u[1] * e[1] + u[2] * e[2] + h[0] * b0[0] + h[1] * b0[1] + h[2] * b0[2]
+        scalar_update(b, P, h, z, W)
 
 
 @kernel()
@@ -192,16 +242,20 @@ def run(state, coef, gyr, acc, offset, variance):
             g2 += state[i] ** 2
         still = dg2 < rest_gyr * rest_gyr and da2 < rest_acc * rest_acc and g2 < rest_gyr_abs * rest_gyr_abs
         state[6] = state[6] + Ts if still else 0.0
-        old = acc_lp[0].copy()
+        old = (acc_lp[0, 0], acc_lp[0, 1], acc_lp[0, 2])
         if V > 0.0:  # tracking while moving: the gyro frame and its low-passes
             q = quat_normalized(quat_multiply(  # turned by the corrected gyro
                 (state[11], state[12], state[13], state[14]),
                 rotvec_quat((gyr[k, 0] - b[0]) * Ts, (gyr[k, 1] - b[1]) * Ts, (gyr[k, 2] - b[2]) * Ts)))
             state[11], state[12], state[13], state[14] = q
             state[T] += Ts
-            # the accelerometer, R·b and R (column j: the sensor's axis j) low-passed
-            a = quat_rotate(q, (acc[k, 0], acc[k, 1], acc[k, 2]))
-            rb = quat_rotate(q, (b[0], b[1], b[2]))
+            # the accelerometer, R·b and R (row-major) low-passed
+            R = quat_matrix(q)
+            a = (R[0] * acc[k, 0] + R[1] * acc[k, 1] + R[2] * acc[k, 2],
+                 R[3] * acc[k, 0] + R[4] * acc[k, 1] + R[5] * acc[k, 2],
+                 R[6] * acc[k, 0] + R[7] * acc[k, 1] + R[8] * acc[k, 2])
+            rb = (R[0] * b[0] + R[1] * b[1] + R[2] * b[2], R[3] * b[0] + R[4] * b[1] + R[5] * b[2],
+                  R[6] * b[0] + R[7] * b[1] + R[8] * b[2])
             mean = state[T] <= start_mean
             for i in range(3):
                 if mean:  # the running mean, derivative row at rest
@@ -210,16 +264,14 @@ def run(state, coef, gyr, acc, offset, variance):
                 else:
                     lowpass_step(acc_lp, i, a[i], Ad, Bd)
                 lowpass_step(rb_lp, i, rb[i], Ad, Bd)
-            for j in range(3):
-                col = quat_rotate(q, (1.0 if j == 0 else 0.0, 1.0 if j == 1 else 0.0, 1.0 if j == 2 else 0.0))
-                for i in range(3):
-                    lowpass_step(r_lp, 3 * i + j, col[i], Ad, Bd)
+            for i in range(9):
+                lowpass_step(r_lp, i, R[i], Ad, Bd)
         for i in range(3):
             P[i, i] = min(P[i, i] + V, P0)
-        if state[6] >= rest_time:  # the gyro sample measures b with variance r
-            K = P @ np.linalg.inv(P + r * np.eye(3))
-            b += K @ (gyr[k] - b)
-            P -= K @ P
+        if state[6] >= rest_time:  # each axis of the gyro sample measures b with variance r
+            for i in range(3):
+                scalar_update(b, P, (1.0 if i == 0 else 0.0, 1.0 if i == 1 else 0.0, 1.0 if i == 2 else 0.0),
+                              gyr[k, i], r)
         elif V > 0.0 and state[T] > settle:
             motion_update(b, P, old, acc_lp[0], r_lp[0], rb_lp[0], Ts, W, clip)
         for i in range(3):

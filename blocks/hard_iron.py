@@ -63,9 +63,18 @@ STATE_SIZE = len(STATE_NAMES)
 
 
 def coefficients(params, Ts: float) -> np.ndarray:
-    """[mag_cal_time/Ts (steps; 0: off), mag_cal_spread, mag_cal_tol, mag_cal_recent/Ts (steps)]."""
-    return np.array([params["mag_cal_time"] / Ts, params["mag_cal_spread"], params["mag_cal_tol"],
-                     params["mag_cal_recent"] / Ts])
+    """[mag_cal_time/Ts (steps; 0: off), mag_cal_spread, mag_cal_tol, mag_cal_recent/Ts
+    (steps), 1 − exp(−Ts/mag_cal_time) (0 when off), 1 − exp(−Ts/mag_cal_recent)]."""
+    cal_steps, recent_steps = params["mag_cal_time"] / Ts, params["mag_cal_recent"] / Ts
+    return np.array([cal_steps, params["mag_cal_spread"], params["mag_cal_tol"], recent_steps,
+                     -math.expm1(-1.0 / cal_steps) if cal_steps > 0.0 else 0.0, -math.expm1(-1.0 / recent_steps)])
+
+
+@kernel(inline=True)
+def pull(gap, rate, one_step):
+    """1 − exp(−gap·rate), the weight of a first-order low-pass over gap steps (rate per
+    step); one_step is its value for one step, the usual gap."""
+    return one_step if gap == 1.0 else 1.0 - math.exp(-gap * rate)
 
 
 @kernel(inline=True)
@@ -79,43 +88,58 @@ def _accumulate(s, m, forget):
 
 
 @kernel(inline=True)
-def _moments(s):
-    """The field's mean (3) and second moment (3×3) from the sums s."""
+def _covariance(s):
+    """The field's mean (3-tuple) and covariance (xx, xy, xz, yy, yz, zz) from the sums s."""
     w = 1.0 / s[0]
-    return (np.array([s[1], s[2], s[3]]) * w,
-            np.array([[s[4], s[5], s[6]], [s[5], s[7], s[8]], [s[6], s[8], s[9]]]) * w)
+    mx, my, mz = s[1] * w, s[2] * w, s[3] * w
+    return (mx, my, mz), (s[4] * w - mx * mx, s[5] * w - mx * my, s[6] * w - mx * mz,
+                          s[7] * w - my * my, s[8] * w - my * mz, s[9] * w - mz * mz)
 
 
 @kernel(inline=True)
 def _spread(s):
-    """The s.d. of the field across its smallest axis (the field's unit)."""
-    mu, second = _moments(s)
-    return math.sqrt(max(np.linalg.eigvalsh(second - np.outer(mu, mu))[0], 0.0))
+    """The s.d. of the field across its smallest axis (the field's unit): the square root
+    of the covariance's least eigenvalue, in the closed form of a symmetric 3×3 matrix."""
+    xx, xy, xz, yy, yz, zz = _covariance(s)[1]
+    mean = (xx + yy + zz) / 3.0
+    off2 = xy * xy + xz * xz + yz * yz
+    p = math.sqrt(((xx - mean) ** 2 + (yy - mean) ** 2 + (zz - mean) ** 2 + 2.0 * off2) / 6.0)
+    if p == 0.0:
+        return math.sqrt(max(mean, 0.0))
+    a, d, f = (xx - mean) / p, (yy - mean) / p, (zz - mean) / p
+    b, c, e = xy / p, xz / p, yz / p
+    half_det = 0.5 * (a * (d * f - e * e) - b * (b * f - c * e) + c * (b * e - c * d))
+    angle = math.acos(min(max(half_det, -1.0), 1.0)) / 3.0
+    return math.sqrt(max(mean + 2.0 * p * math.cos(angle + 2.0 * math.pi / 3.0), 0.0))
 
 
 @kernel(inline=True)
 def _fit(s):
-    """(b (3), radius, rms distance from the fitted sphere, the same for the sphere about 0),
-    all in the field's unit; radius 0: no fit."""
-    mu, second = _moments(s)
+    """(b (3-tuple), radius, rms distance from the fitted sphere, the same for the sphere
+    about 0), all in the field's unit; radius 0: no fit. With c eliminated, the fit is
+    2·C·b = E[m·|m|²] − μ·E|m|² (C the field's covariance, μ its mean), c = E|m|² − 2μ·b."""
+    mu, (xx, xy, xz, yy, yz, zz) = _covariance(s)
     n2, n4 = s[13] / s[0], s[14] / s[0]
     raw_radius = math.sqrt(n2)
     raw_distance = math.sqrt(max(n4 - n2 * n2, 0.0)) / (2.0 * raw_radius)
-    M = np.empty((4, 4))
-    M[0:3, 0:3] = 4.0 * second
-    M[0:3, 3] = 2.0 * mu
-    M[3, 0:3] = 2.0 * mu
-    M[3, 3] = 1.0
-    v = np.array([2.0 * s[10] / s[0], 2.0 * s[11] / s[0], 2.0 * s[12] / s[0], n2])
-    if abs(np.linalg.det(M)) < 1e-12 * 64.0 * n2 ** 3:  # too few directions for a sphere
-        return mu * 0.0, 0.0, 0.0, raw_radius, raw_distance
-    theta = np.linalg.solve(M, v)
-    b = theta[0:3]
-    r2 = theta[3] + b[0] * b[0] + b[1] * b[1] + b[2] * b[2]
+    # the adjugate of C and its determinant
+    a0, a1, a2 = yy * zz - yz * yz, xz * yz - xy * zz, xy * yz - xz * yy
+    a4, a5, a8 = xx * zz - xz * xz, xy * xz - xx * yz, xx * yy - xy * xy
+    det = xx * a0 + xy * a1 + xz * a2
+    if abs(det) < 1e-12 * n2 ** 3:  # too few directions for a sphere
+        return (0.0, 0.0, 0.0), 0.0, 0.0, raw_radius, raw_distance
+    w = 0.5 / s[0]  # the right-hand side halved, over det
+    v0 = (s[10] * w - 0.5 * mu[0] * n2) / det
+    v1 = (s[11] * w - 0.5 * mu[1] * n2) / det
+    v2 = (s[12] * w - 0.5 * mu[2] * n2) / det
+    b = (a0 * v0 + a1 * v1 + a2 * v2, a1 * v0 + a4 * v1 + a5 * v2, a2 * v0 + a5 * v1 + a8 * v2)
+    c = n2 - 2.0 * (mu[0] * b[0] + mu[1] * b[1] + mu[2] * b[2])
+    r2 = c + b[0] * b[0] + b[1] * b[1] + b[2] * b[2]
     if r2 <= 0.0:
-        return b * 0.0, 0.0, 0.0, raw_radius, raw_distance
+        return (0.0, 0.0, 0.0), 0.0, 0.0, raw_radius, raw_distance
     radius = math.sqrt(r2)
-    residual2 = n4 - 2.0 * (theta @ v) + theta @ (M @ theta)  # mean of (|m|² − 2m·b − c)²
+    # mean of (|m|² − 2m·b − c)² at the solution: E|m|⁴ − 2b·E[m·|m|²] − c·E|m|²
+    residual2 = n4 - 4.0 * w * (b[0] * s[10] + b[1] * s[11] + b[2] * s[12]) - c * n2
     return b, radius, math.sqrt(max(residual2, 0.0)) / (2.0 * radius), raw_radius, raw_distance
 
 
@@ -146,10 +170,10 @@ def hard_iron_step(state, coef, m, gap, norm_tol, steady_steps):
     cal_steps, spread_min, tol, recent_steps = coef[0], coef[1], coef[2], coef[3]
     if cal_steps <= 0.0:
         return m, False
-    _accumulate(state[SUMS], m, math.exp(-gap / cal_steps))
+    _accumulate(state[SUMS], m, 1.0 - pull(gap, 1.0 / cal_steps, coef[4]))
     state[AGE] += gap
     b, radius, distance, raw_radius, raw_distance = _fit(state[SUMS])
-    a = 1.0 - math.exp(-gap / recent_steps)
+    a = pull(gap, 1.0 / recent_steps, coef[5])
     recent_fit = _recent(state, RECENT_FIT, m, b, radius, a)
     recent_raw = _recent(state, RECENT_RAW, m, (0.0, 0.0, 0.0), raw_radius, a)
     fits = radius > 0.0 and distance < tol * radius
@@ -171,7 +195,8 @@ def hard_iron_step(state, coef, m, gap, norm_tol, steady_steps):
         state[FIT_STEPS] += gap
         state[RAW_STEPS] = 0.0
         if state[FIT_STEPS] >= steady_steps:
-            state[OFFSET] = b
+            for i in range(3):
+                state[OFFSET.start + i] = b[i]
             changed = not was_used
     elif raw_fits:
         state[RAW_STEPS] += gap

@@ -32,7 +32,7 @@ import math
 import numpy as np
 
 from . import hard_iron
-from .hard_iron import hard_iron_step
+from .hard_iron import hard_iron_step, pull
 from .jit import kernel
 from .methods import Param, resolve_params
 from .quaternion import quat_multiply, quat_rotate
@@ -65,12 +65,13 @@ def resolve(overrides=None) -> dict:
 
 def coefficients(params, Ts: float) -> np.ndarray:
     """[Ts/tau_heading, Ts/tau_reference, mag_norm_tol, mag_dip_tol, heading_clip, steps a
-    new field must stay steady, cos(mag_new_angle/2), 1 − exp(−Ts/tau_heading), then
-    blocks.hard_iron's coefficients]. Ts is the step (IMU sample) time."""
+    new field must stay steady, cos(mag_new_angle/2), 1 − exp(−Ts/tau_heading),
+    1 − exp(−Ts/tau_reference), then blocks.hard_iron's coefficients]. Ts is the step
+    (IMU sample) time."""
     return np.concatenate([[Ts / params["tau_heading"], Ts / params["tau_reference"],
                             params["mag_norm_tol"], params["mag_dip_tol"], params["heading_clip"],
                             params["mag_new_time"] / Ts, math.cos(0.5 * params["mag_new_angle"]),
-                            1.0 - math.exp(-Ts / params["tau_heading"])],
+                            1.0 - math.exp(-Ts / params["tau_heading"]), 1.0 - math.exp(-Ts / params["tau_reference"])],
                            hard_iron.coefficients(params, Ts)])
 
 
@@ -140,8 +141,8 @@ def _field_sample(state, coef, q, m, horizontal):
         state[REF_NORM] += (norm - state[REF_NORM]) / state[SEEN]
         state[REF_DIP] += (dip - state[REF_DIP]) / state[SEEN]
     elif ok:  # first-order pulls over the time since the last field sample
-        state[0] += (1.0 - math.exp(-gap * coef[0])) * min(clip, max(-clip, math.atan2(m[0], m[1])))
-        a_reference = 1.0 - math.exp(-gap * coef[1])
+        state[0] += pull(gap, coef[0], coef[7]) * min(clip, max(-clip, math.atan2(m[0], m[1])))
+        a_reference = pull(gap, coef[1], coef[8])
         state[REF_NORM] += a_reference * (norm - state[REF_NORM])
         state[REF_DIP] += a_reference * (dip - state[REF_DIP])
     return ok
@@ -159,7 +160,7 @@ def heading_step(state, coef, q, m_sensor):
     ok = False
     n2 = m_sensor[0] * m_sensor[0] + m_sensor[1] * m_sensor[1] + m_sensor[2] * m_sensor[2]
     if math.isfinite(n2) and n2 > 0.0:  # a field sample (not NaN: missing, not all 0: none)
-        m_sensor, proven = hard_iron_step(state[HARD_IRON], coef[8:], m_sensor, state[GAP], coef[2], coef[5])
+        m_sensor, proven = hard_iron_step(state[HARD_IRON], coef[9:], m_sensor, state[GAP], coef[2], coef[5])
         if proven:  # a field freed of (or back without) an offset: start afresh from it
             state[SEEN] = 0.0
         half = 0.5 * state[0]
@@ -167,7 +168,8 @@ def heading_step(state, coef, q, m_sensor):
         horizontal = math.sqrt(m[0] * m[0] + m[1] * m[1])
         if horizontal > 0.0:  # a field with a heading
             ok = _field_sample(state, coef, q, m, horizontal)
-    state[0] = math.atan2(math.sin(state[0]), math.cos(state[0]))
+    if abs(state[0]) > math.pi:
+        state[0] = math.atan2(math.sin(state[0]), math.cos(state[0]))
     half = 0.5 * state[0]
     return quat_multiply((math.cos(half), 0.0, 0.0, math.sin(half)), q), ok
 

@@ -55,6 +55,15 @@ def quat_rotate(q, v):
 
 
 @kernel(inline=True)
+def quat_matrix(q):
+    """The rotation matrix of the unit quaternion q, row-major (9-tuple)."""
+    w, x, y, z = q
+    return (1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - w * z), 2.0 * (x * z + w * y),
+            2.0 * (x * y + w * z), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - w * x),
+            2.0 * (x * z - w * y), 2.0 * (y * z + w * x), 1.0 - 2.0 * (x * x + y * y))
+
+
+@kernel(inline=True)
 def quat_normalized(q):
     """q scaled to unit norm."""
     inv = 1.0 / math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])

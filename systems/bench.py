@@ -13,14 +13,17 @@ from .sensor_model import ImuModel
 BENCH_FS = 100.0  # Hz
 
 
-def bench_recording(n: int = 100_000, seed: int = 0):
+def bench_recording(n: int = 100_000, seed: int = 0, mag: bool = False):
     """A human-motion recording of n samples (about 3.5 m/s² RMS acceleration per axis)
-    with a MEMS-grade gyro: (gyr, acc)."""
+    with a MEMS-grade gyro: (gyr, acc), and with mag a magnetometer (µT, 0.1 µT/√Hz) as
+    well: (gyr, acc, mag)."""
     motion = HumanMotion(delta_v=0.1, omega_c=5.0).generate(n / BENCH_FS, BENCH_FS, seed)
-    return ImuModel(delta_n=np.radians(0.01)).apply(motion, seed + 1)
+    imu = ImuModel(delta_n=np.radians(0.01), mag_noise=0.1)
+    gyr, acc = imu.apply(motion, seed + 1)
+    return (gyr, acc, imu.apply_mag(motion, seed + 1)) if mag else (gyr, acc)
 
 
-def _runners(gyr, acc):
+def _runners(gyr, acc, mag):
     try:
         import vqf
         from ahrs.filters import Madgwick
@@ -31,22 +34,26 @@ def _runners(gyr, acc):
     return {
         "wiener": lambda: estimate(gyr, acc, BENCH_FS),  # local noise densities (the default)
         "wiener_stationary": lambda: estimate(gyr, acc, BENCH_FS, "wiener", {"stationary": 1}),
-        "vqf": lambda: vqf.VQF(Ts).updateBatch(gyr, acc),
+        # what `attitude estimate` runs on a recording: the gyro-offset estimator, and heading
+        "wiener_offset": lambda: estimate(gyr, acc, BENCH_FS, gyro_offset=True),
+        "wiener_9d": lambda: estimate(gyr, acc, BENCH_FS, gyro_offset=True, mag=mag),
+        "vqf": lambda: vqf.VQF(Ts).updateBatch(gyr, acc),  # with its gyro-bias estimation
+        "vqf_9d": lambda: vqf.VQF(Ts).updateBatch(gyr, acc, mag),
         "madgwick": lambda: Madgwick(gyr=gyr, acc=acc, frequency=BENCH_FS),
     }
 
 
 def bench(n: int = 100_000, repeat: int = 5, budget_s: float = 3.0, progress: bool = True) -> dict:
-    """Best samples per second of each method over up to `repeat` interleaved rounds.
+    """Best samples per second of each method over up to `repeat` interleaved rounds, and
+    their ratios to vqf's 6D and 9D filters.
 
     Rounds alternate the methods so that the machine's load changes hit all alike; a
     method leaves the rounds once its runs have taken budget_s (it always runs once).
     """
-    gyr, acc = bench_recording(n)
-    gyr, acc = np.ascontiguousarray(gyr), np.ascontiguousarray(acc)
-    runners = _runners(gyr, acc)
+    gyr, acc, mag = map(np.ascontiguousarray, bench_recording(n, mag=True))
+    runners = _runners(gyr, acc, mag)
     for params in (None, {"stationary": 1}):  # compile (or load) the kernels outside the timing
-        estimate(gyr[:10], acc[:10], BENCH_FS, "wiener", params)
+        estimate(gyr[:10], acc[:10], BENCH_FS, "wiener", params, gyro_offset=True, mag=mag[:10])
     best = dict.fromkeys(runners, np.inf)
     spent = dict.fromkeys(runners, 0.0)
     for round_ in range(repeat):
@@ -64,6 +71,7 @@ def bench(n: int = 100_000, repeat: int = 5, budget_s: float = 3.0, progress: bo
         "samples": n,
         "samples_per_s": rates,
         "ratio_vs_vqf": {name: rate / rates["vqf"] for name, rate in rates.items()},
+        "ratio_vs_vqf_9d": {name: rate / rates["vqf_9d"] for name, rate in rates.items()},
     }
 
 

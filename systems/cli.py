@@ -399,9 +399,9 @@ def cmd_bench(args) -> int:
         print(json.dumps(result, indent=2))
     else:
         print(f"{result['samples']} samples, best of up to {args.repeat} runs")
-        print(f"{'method':>18} {'samples/s':>14} {'vs vqf':>8}")
+        print(f"{'method':>18} {'samples/s':>14} {'vs vqf':>8} {'vs vqf_9d':>10}")
         for name, rate in result["samples_per_s"].items():
-            print(f"{name:>18} {rate:14.4g} {result['ratio_vs_vqf'][name]:8.2f}")
+            print(f"{name:>18} {rate:14.4g} {result['ratio_vs_vqf'][name]:8.2f} {result['ratio_vs_vqf_9d'][name]:10.2f}")
     return 0
 
 
