@@ -199,14 +199,24 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _check_out(path, source=None) -> None:
-    """Refuse, before any work is done, an output file whose folder does not exist or that
-    is the input file source (writing it would lose the recording)."""
+def _check_out(path, source=None, figure: bool = False) -> None:
+    """Refuse, before any work is done, an output file whose folder does not exist, that is
+    a folder, or that is the input file source (writing it would lose the recording); a
+    figure (figure=True) also in a format matplotlib cannot write."""
     folder = Path(path).absolute().parent
     if not folder.is_dir():
         raise ValueError(f"cannot write {path}: there is no folder {folder}")
+    if Path(path).is_dir():
+        raise ValueError(f"cannot write {path}: it is a folder; give a file name")
     if source is not None and Path(path).resolve() == Path(source).resolve():
         raise ValueError(f"cannot write {path}: it is the input; choose another --out")
+    if figure:
+        from matplotlib.figure import Figure
+
+        formats = Figure().canvas.get_supported_filetypes()
+        if Path(path).suffix.lstrip(".").lower() not in formats:
+            raise ValueError(f"cannot write {path}: a figure's file name ends in one of "
+                             f"{', '.join('.' + f for f in sorted(formats))} (e.g. .png)")
 
 
 def cmd_estimate(args) -> int:
@@ -279,7 +289,7 @@ def cmd_evaluate(args) -> int:
 def cmd_plot(args) -> int:
     from .plot import plot_recording
 
-    _check_out(args.out, args.file)
+    _check_out(args.out, args.file, figure=True)
     result = plot_recording(args.file, args.out, args.method, dict(args.param), args.offline,
                             args.gyro_offset == "on", args.heading == "mag", _read_options(args), args.latency,
                             args.gyr_samples)
@@ -371,7 +381,7 @@ def cmd_bode(args) -> int:
     from .bode import plot
 
     out = args.out or f"bode_{args.method}.png"
-    _check_out(out)
+    _check_out(out, figure=True)
     plot(args.method, out)
     print(f"attitude: wrote {out}", file=sys.stderr)
     return 0

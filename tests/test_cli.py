@@ -219,6 +219,15 @@ def test_bad_input_ends_with_a_message_and_exit_2(tmp_path, imu, capsys):
         assert main([*command, "--out", str(tmp_path / "sub" / ".." / "good.csv")]) == 2
         assert "it is the input; choose another --out" in capsys.readouterr().err
     assert (tmp_path / "good.csv").read_bytes() == before
+    # an output that is a folder, or a figure in a format matplotlib does not write
+    for command, out, message in ((["estimate"], tmp_path / "sub", "it is a folder; give a file name"),
+                                  (["plot", "--method", "wiener"], tmp_path / "sub", "it is a folder"),
+                                  (["plot", "--method", "wiener"], tmp_path / "p.txt", "ends in one of")):
+        assert main([command[0], str(tmp_path / "good.csv"), *command[1:], "--out", str(out)]) == 2
+        err = capsys.readouterr().err
+        assert message in err and "attitude: read" not in err, err
+    assert main(["bode", "--out", str(tmp_path / "b.txt")]) == 2
+    assert ".png" in capsys.readouterr().err and not (tmp_path / "b.txt").exists()
 
 
 def test_console_entry_point_reports_errors_without_traceback(tmp_path):
