@@ -129,9 +129,11 @@ def build_parser() -> argparse.ArgumentParser:
         formatter_class=argparse.RawDescriptionHelpFormatter,
         epilog="methods and estimators, and their parameters (a name under several sets it in each):\n" + _method_help(),
     )
-    est.add_argument("input", help="CSV (t,gyr_x,gyr_y,gyr_z,acc_x,acc_y,acc_z[,mag_x,mag_y,mag_z]; "
-                     "separated by commas, semicolons or tabs) or BROAD .mat")
-    est.add_argument("--out", required=True, help="output CSV: t,q_w,q_x,q_y,q_z,g_x,g_y,g_z")
+    est.add_argument("input", nargs="+", help="CSV (t,gyr_x,gyr_y,gyr_z,acc_x,acc_y,acc_z[,mag_x,mag_y,mag_z]; "
+                     "separated by commas, semicolons or tabs) or BROAD .mat; several: each is estimated "
+                     "with the same flags")
+    est.add_argument("--out", required=True, help="output CSV: t,q_w,q_x,q_y,q_z,g_x,g_y,g_z; or a folder that receives "
+                     "NAME.csv for input NAME.csv or NAME.mat (with several inputs, made if absent)")
     est.add_argument("--euler", action="store_true",
                      help="add roll_deg,pitch_deg,yaw_deg to the output (Z-Y-X sequence of q, degrees)")
     est.add_argument("--offsets", action="store_true",
@@ -219,21 +221,68 @@ def _check_out(path, source=None, figure: bool = False) -> None:
                              f"{', '.join('.' + f for f in sorted(formats))} (e.g. .png)")
 
 
+def _estimate_outputs(inputs, out) -> list:
+    """The output file of each input: out itself for one input, unless out is a folder; for
+    several, out is a folder (made here if absent, its parent must exist). In a folder,
+    input NAME.ext gives out/NAME.csv. Refused before any work: two inputs of one name,
+    an output that is an input."""
+    if len(inputs) == 1 and not Path(out).is_dir():
+        _check_out(out, inputs[0])
+        return [out]
+    folder = Path(out)
+    if folder.exists() and not folder.is_dir():
+        raise ValueError(f"cannot write into {out}: with {len(inputs)} inputs --out is a folder, and it is a file")
+    stems = [Path(path).stem for path in inputs]
+    repeated = sorted({stem for stem in stems if stems.count(stem) > 1})
+    if repeated:
+        raise ValueError(f"inputs share the names {', '.join(repeated)}: their outputs in {out} would overwrite "
+                         "each other; estimate them in separate runs")
+    if not folder.is_dir():
+        _check_out(folder)  # the folder to make: its parent must exist
+    outputs = [folder / f"{stem}.csv" for stem in stems]
+    for path in outputs:
+        if any(path.resolve() == Path(source).resolve() for source in inputs):
+            raise ValueError(f"cannot write {path}: it is an input; choose another --out")
+        if path.is_dir():
+            raise ValueError(f"cannot write {path}: it is a folder")
+    folder.mkdir(exist_ok=True)
+    return outputs
+
+
 def cmd_estimate(args) -> int:
+    """Each input in turn; one that fails is reported and the others still run (exit 2)."""
+    outputs = _estimate_outputs(args.input, args.out)
+    failed = []
+    for number, (path, out) in enumerate(zip(args.input, outputs), 1):
+        prefix = f"[{number}/{len(outputs)}] " if len(outputs) > 1 else ""
+        try:
+            _estimate_one(args, path, out, prefix)
+        except (ValueError, OSError, RuntimeError) as exc:
+            if len(outputs) == 1:
+                raise
+            print(f"attitude: {prefix}error: {exc}", file=sys.stderr, flush=True)
+            failed.append(path)
+    if failed:
+        print(f"attitude: error: {len(failed)} of {len(outputs)} inputs failed ({', '.join(failed)}); "
+              f"the others are in {args.out}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    return 0
+
+
+def _estimate_one(args, path, out, prefix: str) -> None:
     from .batch import estimate
     from .recording import field_norm_note, print_notes, read_recording, write_estimate
 
-    _check_out(args.out, args.input)
     clock = time.perf_counter()
 
     def progress(text):  # each stage takes about 3 s per million samples
         nonlocal clock
         now = time.perf_counter()
-        print(f"attitude: {text} ({now - clock:.1f} s)", file=sys.stderr, flush=True)
+        print(f"attitude: {prefix}{text} ({now - clock:.1f} s)", file=sys.stderr, flush=True)
         clock = now
 
-    rec = read_recording(args.input, **_read_options(args))
-    progress(f"read {len(rec.gyr)} samples at {rec.fs:g} Hz from {args.input}")
+    rec = read_recording(path, **_read_options(args))
+    progress(f"read {len(rec.gyr)} samples at {rec.fs:g} Hz from {path}")
     print_notes(rec.notes + ([field_norm_note(rec)] if args.heading == "mag" else []))
     result = estimate(rec.gyr, rec.acc, rec.fs, args.method, dict(args.param), offline=args.offline,
                       gyro_offset=args.gyro_offset == "on", mag=rec.mag if args.heading == "mag" else None,
@@ -245,18 +294,17 @@ def cmd_estimate(args) -> int:
         extra["gyr_offset"] = np.zeros_like(rec.gyr) if result.offset is None else result.offset
         if result.mag_offset is not None:
             extra["mag_offset"] = result.mag_offset
-    write_estimate(args.out, rec.t[rows], result.quat[rows], result.up[rows], euler=args.euler,
+    write_estimate(out, rec.t[rows], result.quat[rows], result.up[rows], euler=args.euler,
                    extra={name: values[rows] for name, values in extra.items()})
-    progress(f"wrote {args.out}")
+    progress(f"wrote {out}")
     if result.offset is not None:
-        print("attitude: gyro offset estimate at the end "
+        print(f"attitude: {prefix}gyro offset estimate at the end "
               f"({', '.join(f'{v:.3f}' for v in np.degrees(result.offset[-1]))}) °/s", file=sys.stderr)
     if result.mag_accepted is not None:
         sampled = np.isfinite(rec.mag).all(axis=1)  # rows where a slower magnetometer has a sample
-        print(f"attitude: magnetometer samples used for heading {100 * result.mag_accepted[sampled].mean():.0f} %, "
-              f"hard-iron offset at the end ({', '.join(f'{v:.1f}' for v in result.mag_offset[-1])}) µT",
-              file=sys.stderr)
-    return 0
+        print(f"attitude: {prefix}magnetometer samples used for heading "
+              f"{100 * result.mag_accepted[sampled].mean():.0f} %, hard-iron offset at the end "
+              f"({', '.join(f'{v:.1f}' for v in result.mag_offset[-1])}) µT", file=sys.stderr)
 
 
 def cmd_evaluate(args) -> int:

@@ -219,15 +219,43 @@ def test_bad_input_ends_with_a_message_and_exit_2(tmp_path, imu, capsys):
         assert main([*command, "--out", str(tmp_path / "sub" / ".." / "good.csv")]) == 2
         assert "it is the input; choose another --out" in capsys.readouterr().err
     assert (tmp_path / "good.csv").read_bytes() == before
-    # an output that is a folder, or a figure in a format matplotlib does not write
-    for command, out, message in ((["estimate"], tmp_path / "sub", "it is a folder; give a file name"),
-                                  (["plot", "--method", "wiener"], tmp_path / "sub", "it is a folder"),
+    # a figure written to a folder, or in a format matplotlib does not write
+    for command, out, message in ((["plot", "--method", "wiener"], tmp_path / "sub", "it is a folder"),
                                   (["plot", "--method", "wiener"], tmp_path / "p.txt", "ends in one of")):
         assert main([command[0], str(tmp_path / "good.csv"), *command[1:], "--out", str(out)]) == 2
         err = capsys.readouterr().err
         assert message in err and "attitude: read" not in err, err
     assert main(["bode", "--out", str(tmp_path / "b.txt")]) == 2
     assert ".png" in capsys.readouterr().err and not (tmp_path / "b.txt").exists()
+
+
+def test_several_inputs_each_give_their_own_output_and_one_that_fails_stops_none(tmp_path, imu, capsys):
+    gyr, acc = imu
+    (tmp_path / "in").mkdir()
+    _write_csv(tmp_path / "in" / "left.csv", _imu_columns(gyr, acc))
+    _write_csv(tmp_path / "in" / "right.csv", _imu_columns(gyr[::-1].copy(), acc[::-1].copy()))
+    _write_csv(tmp_path / "in" / "broken.csv", {"t": np.arange(3.0), "gyr_x": np.zeros(3)})
+    inputs = [str(tmp_path / "in" / f"{name}.csv") for name in ("left", "broken", "right")]
+    assert main(["estimate", *inputs, "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert "[2/3] error:" in err and "missing columns" in err and "1 of 3 inputs failed" in err, err
+    for name, (g, a) in (("left", (gyr, acc)), ("right", (gyr[::-1], acc[::-1]))):
+        ref = estimate(g, a, FS, gyro_offset=True)
+        assert np.abs(_read_output(tmp_path / "out" / f"{name}.csv")[1][:, 1:5] - ref.quat).max() < 1e-9
+    assert not (tmp_path / "out" / "broken.csv").exists()
+    # one input into a folder that exists
+    assert main(["estimate", inputs[0], "--out", str(tmp_path / "in")]) == 2  # would overwrite the input
+    assert "it is an input" in capsys.readouterr().err
+    (tmp_path / "one").mkdir()
+    assert main(["estimate", inputs[0], "--out", str(tmp_path / "one")]) == 0
+    assert (tmp_path / "one" / "left.csv").exists()
+    # refused before any work: two inputs of one name, a file where the folder should be
+    for out, extra, message in ((tmp_path / "o2", [str(tmp_path / "one" / "left.csv")], "share the names left"),
+                                (tmp_path / "in" / "left.csv", [inputs[2]], "is a file")):
+        assert main(["estimate", inputs[0], *extra, "--out", str(out)]) == 2
+        err = capsys.readouterr().err
+        assert message in err and "attitude: [1/2] read" not in err, err
+    assert not (tmp_path / "o2").exists()
 
 
 def test_console_entry_point_reports_errors_without_traceback(tmp_path):
