@@ -263,8 +263,9 @@ def cmd_estimate(args) -> int:
             print(f"attitude: {prefix}error: {exc}", file=sys.stderr, flush=True)
             failed.append(path)
     if failed:
-        print(f"attitude: error: {len(failed)} of {len(outputs)} inputs failed ({', '.join(failed)}); "
-              f"the others are in {args.out}", file=sys.stderr)
+        written = f"the others are in {args.out}" if len(failed) < len(outputs) else "none was written"
+        print(f"attitude: error: {len(failed)} of {len(outputs)} inputs failed ({', '.join(failed)}); {written}",
+              file=sys.stderr)
         return EXIT_BAD_INPUT
     return 0
 

@@ -243,6 +243,11 @@ def test_several_inputs_each_give_their_own_output_and_one_that_fails_stops_none
         ref = estimate(g, a, FS, gyro_offset=True)
         assert np.abs(_read_output(tmp_path / "out" / f"{name}.csv")[1][:, 1:5] - ref.quat).max() < 1e-9
     assert not (tmp_path / "out" / "broken.csv").exists()
+    (tmp_path / "in" / "broken.csv").rename(tmp_path / "in" / "broken2.csv")
+    _write_csv(tmp_path / "in" / "broken.csv", {"t": np.arange(3.0), "gyr_x": np.zeros(3)})
+    assert main(["estimate", inputs[1], str(tmp_path / "in" / "broken2.csv"), "--out", str(tmp_path / "none")]) == 2
+    err = capsys.readouterr().err
+    assert "2 of 2 inputs failed" in err and "none was written" in err, err
     # one input into a folder that exists
     assert main(["estimate", inputs[0], "--out", str(tmp_path / "in")]) == 2  # would overwrite the input
     assert "it is an input" in capsys.readouterr().err
