@@ -276,7 +276,7 @@ def _estimate_one(args, path, out, prefix: str) -> None:
 
     clock = time.perf_counter()
 
-    def progress(text):  # each stage takes about 3 s per million samples
+    def progress(text):  # reading and writing take about 3 s per million samples
         nonlocal clock
         now = time.perf_counter()
         print(f"attitude: {prefix}{text} ({now - clock:.1f} s)", file=sys.stderr, flush=True)
