@@ -129,14 +129,34 @@ def lowpass_step(rows, j, x, Ad, Bd):
 
 
 @kernel(inline=True)
+def _dot(u, v):
+    """u·v of two 3-vectors."""
+    return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]
+
+
+@kernel(inline=True)
+def _mat_vec(M, v):
+    """M·v for M 3×3 row-major (9 entries) and a 3-vector v."""
+    return (M[0] * v[0] + M[1] * v[1] + M[2] * v[2], M[3] * v[0] + M[4] * v[1] + M[5] * v[2],
+            M[6] * v[0] + M[7] * v[1] + M[8] * v[2])
+
+
+@kernel(inline=True)
+def _mat_t_vec(M, v):
+    """Mᵀ·v for M 3×3 row-major (9 entries) and a 3-vector v."""
+    return (M[0] * v[0] + M[3] * v[1] + M[6] * v[2], M[1] * v[0] + M[4] * v[1] + M[7] * v[2],
+            M[2] * v[0] + M[5] * v[1] + M[8] * v[2])
+
+
+@kernel(inline=True)
 def scalar_update(b, P, h, z, w):
     """Kalman update of the offset b (P its covariance, both in place) from one scalar
     measurement z of h·b with noise variance w."""
     Ph = (P[0, 0] * h[0] + P[0, 1] * h[1] + P[0, 2] * h[2],
           P[1, 0] * h[0] + P[1, 1] * h[1] + P[1, 2] * h[2],
           P[2, 0] * h[0] + P[2, 1] * h[1] + P[2, 2] * h[2])
-    inv_s = 1.0 / (h[0] * Ph[0] + h[1] * Ph[1] + h[2] * Ph[2] + w)
-    innovation = (z - h[0] * b[0] - h[1] * b[1] - h[2] * b[2]) * inv_s
+    inv_s = 1.0 / (_dot(h, Ph) + w)
+    innovation = (z - _dot(h, b)) * inv_s
     for i in range(3):
         b[i] += Ph[i] * innovation
         for j in range(3):
@@ -153,7 +173,7 @@ def plane_basis(n):
         e = (-n[2], 0.0, n[0])
     else:
         e = (n[1], -n[0], 0.0)
-    norm = math.sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2])
+    norm = math.sqrt(_dot(e, e))
     e1 = (e[0] / norm, e[1] / norm, e[2] / norm)
     return e1, (n[1] * e1[2] - n[2] * e1[1], n[2] * e1[0] - n[0] * e1[2], n[0] * e1[1] - n[1] * e1[0])
 
@@ -169,7 +189,7 @@ def motion_update(b, P, old, new, r_lp, rb_lp, Ts, W, clip):
     a basis (e1, e2) across gravity, in closed form. Only directions H keeps
     at least OBSERVED of are used, each as a scalar measurement u·e of (Hᵀu)·b with
     variance W (u orthonormal: the joint update, taken one direction at a time)."""
-    n2 = new[0] * new[0] + new[1] * new[1] + new[2] * new[2]
+    n2 = _dot(new, new)
     if n2 == 0.0:
         return
     norm = math.sqrt(n2)
@@ -179,20 +199,15 @@ def motion_update(b, P, old, new, r_lp, rb_lp, Ts, W, clip):
     s = 1.0 / (n2 * Ts)
     turn = ((old[1] * new[2] - old[2] * new[1]) * s, (old[2] * new[0] - old[0] * new[2]) * s,
             (old[0] * new[1] - old[1] * new[0]) * s)
-    Lb = (r_lp[0] * b[0] + r_lp[1] * b[1] + r_lp[2] * b[2], r_lp[3] * b[0] + r_lp[4] * b[1] + r_lp[5] * b[2],
-          r_lp[6] * b[0] + r_lp[7] * b[1] + r_lp[8] * b[2])
-    along = (rb_lp[0] - Lb[0]) * n[0] + (rb_lp[1] - Lb[1]) * n[1] + (rb_lp[2] - Lb[2]) * n[2]
-    e = (min(max(turn[0] + rb_lp[0] - Lb[0] - along * n[0], -clip), clip),
-         min(max(turn[1] + rb_lp[1] - Lb[1] - along * n[1], -clip), clip),
-         min(max(turn[2] + rb_lp[2] - Lb[2] - along * n[2], -clip), clip))
+    Lb = _mat_vec(r_lp, b)
+    d = (rb_lp[0] - Lb[0], rb_lp[1] - Lb[1], rb_lp[2] - Lb[2])  # LP(R·b̂) − LP(R)·b̂, across gravity below
+    along = _dot(d, n)
+    e = (min(max(turn[0] + d[0] - along * n[0], -clip), clip),
+         min(max(turn[1] + d[1] - along * n[1], -clip), clip),
+         min(max(turn[2] + d[2] - along * n[2], -clip), clip))
     # M = (e1, e2)ᵀ·LP(R), 2×3; the eigenvectors of M·Mᵀ are H's left singular directions
-    m1 = (e1[0] * r_lp[0] + e1[1] * r_lp[3] + e1[2] * r_lp[6], e1[0] * r_lp[1] + e1[1] * r_lp[4] + e1[2] * r_lp[7],
-          e1[0] * r_lp[2] + e1[1] * r_lp[5] + e1[2] * r_lp[8])
-    m2 = (e2[0] * r_lp[0] + e2[1] * r_lp[3] + e2[2] * r_lp[6], e2[0] * r_lp[1] + e2[1] * r_lp[4] + e2[2] * r_lp[7],
-          e2[0] * r_lp[2] + e2[1] * r_lp[5] + e2[2] * r_lp[8])
-    p11 = m1[0] * m1[0] + m1[1] * m1[1] + m1[2] * m1[2]
-    p12 = m1[0] * m2[0] + m1[1] * m2[1] + m1[2] * m2[2]
-    p22 = m2[0] * m2[0] + m2[1] * m2[1] + m2[2] * m2[2]
+    m1, m2 = _mat_t_vec(r_lp, e1), _mat_t_vec(r_lp, e2)
+    p11, p12, p22 = _dot(m1, m1), _dot(m1, m2), _dot(m2, m2)
     half, mean = 0.5 * (p11 - p22), 0.5 * (p11 + p22)
     radius = math.sqrt(half * half + p12 * p12)
     # M·Mᵀ's eigenvalues mean ± radius are H's squared singular values; the eigenvector of
@@ -208,7 +223,7 @@ def motion_update(b, P, old, new, r_lp, rb_lp, Ts, W, clip):
         u = (c * e1[0] + sn * e2[0], c * e1[1] + sn * e2[1], c * e1[2] + sn * e2[2])
         h = (c * m1[0] + sn * m2[0], c * m1[1] + sn * m2[1], c * m1[2] + sn * m2[2])  # Hᵀ·u
         # u·e measures h·b at the b the innovation was taken at; later directions see the update
-        z = u[0] * e[0] + u[1] * e[1] + u[2] * e[2] + h[0] * b0[0] + h[1] * b0[1] + h[2] * b0[2]
+        z = _dot(u, e) + _dot(h, b0)
         scalar_update(b, P, h, z, W)
 
 
@@ -251,11 +266,8 @@ def run(state, coef, gyr, acc, offset, variance):
             state[T] += Ts
             # the accelerometer, R·b and R (row-major) low-passed
             R = quat_matrix(q)
-            a = (R[0] * acc[k, 0] + R[1] * acc[k, 1] + R[2] * acc[k, 2],
-                 R[3] * acc[k, 0] + R[4] * acc[k, 1] + R[5] * acc[k, 2],
-                 R[6] * acc[k, 0] + R[7] * acc[k, 1] + R[8] * acc[k, 2])
-            rb = (R[0] * b[0] + R[1] * b[1] + R[2] * b[2], R[3] * b[0] + R[4] * b[1] + R[5] * b[2],
-                  R[6] * b[0] + R[7] * b[1] + R[8] * b[2])
+            a = _mat_vec(R, (acc[k, 0], acc[k, 1], acc[k, 2]))
+            rb = _mat_vec(R, b)
             mean = state[T] <= start_mean
             for i in range(3):
                 if mean:  # the running mean, derivative row at rest

@@ -67,7 +67,7 @@ def coefficients(params, Ts: float) -> np.ndarray:
     (steps), 1 − exp(−Ts/mag_cal_time) (0 when off), 1 − exp(−Ts/mag_cal_recent)]."""
     cal_steps, recent_steps = params["mag_cal_time"] / Ts, params["mag_cal_recent"] / Ts
     return np.array([cal_steps, params["mag_cal_spread"], params["mag_cal_tol"], recent_steps,
-                     -math.expm1(-1.0 / cal_steps) if cal_steps > 0.0 else 0.0, -math.expm1(-1.0 / recent_steps)])
+                     1.0 - math.exp(-1.0 / cal_steps) if cal_steps > 0.0 else 0.0, 1.0 - math.exp(-1.0 / recent_steps)])
 
 
 @kernel(inline=True)
