@@ -9,6 +9,7 @@ import numpy as np
 
 from scipy.spatial.transform import Rotation
 
+from blocks import gyro_offset as offset_stage, heading as heading_stage
 from blocks.gyro_offset import correct as correct_gyro
 from blocks.heading import with_magnetometer
 from blocks.timing import carry_forward_rows, check_gyr_samples, check_latency, interval_means
@@ -56,6 +57,27 @@ def check_imu(gyr, acc, fs: float) -> tuple[np.ndarray, np.ndarray]:
     return arrays[0], arrays[1]
 
 
+def check_options(method: str = "wiener", params: Mapping[str, float] | None = None, offline: bool = False,
+                  gyro_offset: bool = False, mag: bool = False, latency: float = 0.0, gyr_samples: str = "mean"):
+    """Refuse what estimate() would refuse of its options, before any data is read: an
+    unknown method, a parameter no running stage has or a value out of range, --offline
+    with a method that is not an earth-frame filter, a latency or gyr_samples out of
+    range. mag: whether a magnetometer will be given. Returns the parameters split into
+    the method's, the gyro-offset estimator's and the heading estimator's
+    (blocks.stages.split_params) and the latency (s)."""
+    m = get_method(method)
+    split = split_params(method, params, gyro_offset, mag)
+    m.runs_kernel(m.resolve(split[0]))  # refuses a stationary other than 0 or 1
+    for stage, runs, overrides in ((offset_stage, gyro_offset, split[1]), (heading_stage, mag, split[2])):
+        if runs:
+            stage.resolve(overrides)
+    if offline and not m.is_sensor_frame:
+        raise ValueError(f"offline smoothing needs an earth-frame filter method "
+                         f"({', '.join(n for n, m in METHODS.items() if m.is_sensor_frame)}), not {method!r}")
+    check_gyr_samples(gyr_samples)
+    return split, check_latency(latency)
+
+
 def estimate(
     gyr, acc, fs: float, method: str = "wiener", params: Mapping[str, float] | None = None,
     initial_gravity=None, offline: bool = False, gyro_offset: bool = False, mag=None, latency: float = 0.0,
@@ -79,11 +101,11 @@ def estimate(
     gyr_samples: "mean" (the project's convention: sample k is the mean rate over the
     sample time before it) or "point" (the rate at t_k, turned into means first).
     """
+    (params, offset_params, heading_params), latency = check_options(method, params, offline, gyro_offset,
+                                                                     mag is not None, latency, gyr_samples)
     gyr, acc = check_imu(gyr, acc, fs)
-    latency = check_latency(latency)
-    if check_gyr_samples(gyr_samples) == "point":
+    if gyr_samples == "point":
         gyr = interval_means(gyr)
-    params, offset_params, heading_params = split_params(method, params, gyro_offset, mag is not None)
     offset = None
     if gyro_offset:
         gyr, offset = correct_gyro(gyr, acc, fs, offset_params, offline=offline)
@@ -94,9 +116,6 @@ def estimate(
         forward = _run(step, gyr, acc, initial_gravity)
         forward.offset = offset
         return _carried_forward(_with_heading(forward, mag, fs, heading_params), gyr, latency)
-    if not get_method(method).is_sensor_frame:
-        raise ValueError(f"offline smoothing needs an earth-frame filter method "
-                         f"({', '.join(n for n, m in METHODS.items() if m.is_sensor_frame)}), not {method!r}")
     gyr_back = time_reversed(gyr)
     if isinstance(step, KernelStepper):
         # wiener's local densities: both passes run at the lower of the break frequencies

@@ -251,6 +251,10 @@ def _estimate_outputs(inputs, out) -> list:
 
 def cmd_estimate(args) -> int:
     """Each input in turn; one that fails is reported and the others still run (exit 2)."""
+    from .batch import check_options
+
+    check_options(args.method, dict(args.param), args.offline, args.gyro_offset == "on", args.heading == "mag",
+                  args.latency, args.gyr_samples)
     outputs = _estimate_outputs(args.input, args.out)
     failed = []
     for number, (path, out) in enumerate(zip(args.input, outputs), 1):

@@ -11,9 +11,9 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 from scipy.spatial.transform import Rotation
 
-from blocks.timing import carry_forward_rows, check_gyr_samples, check_latency, interval_means
+from blocks.timing import carry_forward_rows, interval_means
 
-from .batch import estimate
+from .batch import check_options, estimate
 from .compare import peer_quaternions
 from .errors import quaternion_errors
 from .recording import Recording, print_notes, read_recording
@@ -110,8 +110,8 @@ def evaluate(paths, method: str = "wiener", params=None, offline: bool = False, 
     read and checked first. A recording's name is its file's stem, or its path where
     stems repeat. progress also prints how each file was read where it matters (time
     stamps, no movement flag)."""
-    check_latency(latency)
-    point = check_gyr_samples(gyr_samples) == "point"
+    check_options(method, params, offline, gyro_offset, use_mag, latency, gyr_samples)
+    point = gyr_samples == "point"
     read = []  # every file read and checked before any estimate: a bad last file costs nothing
     for path in paths:
         rec = read_recording(path, **(read_options or {}))

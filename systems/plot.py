@@ -12,7 +12,7 @@ from blocks import accuracy
 from blocks.methods import design_delta_v, method as get_method
 from blocks.stages import split_params
 
-from .batch import estimate
+from .batch import check_options, estimate
 from .errors import quaternion_errors
 from .recording import RecordingError, euler_degrees, print_notes, read_recording
 
@@ -34,6 +34,7 @@ def plot_recording(path, out, method: str = "wiener", params=None, offline: bool
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    check_options(method, params, offline, gyro_offset, heading, latency, gyr_samples)
     rec = read_recording(path, **(read_options or {}))
     print_notes(rec.notes)
     valid = None if rec.quat_ref is None else rec.evaluated()

@@ -263,6 +263,27 @@ def test_several_inputs_each_give_their_own_output_and_one_that_fails_stops_none
     assert not (tmp_path / "o2").exists()
 
 
+def test_options_are_refused_before_any_input_is_read(tmp_path, capsys):
+    """Inputs that do not exist: the error must name the option, so nothing was read."""
+    absent = [str(tmp_path / "a.csv"), str(tmp_path / "b.csv")]
+    cases = ((["--method", "luinge", "--offline"], "offline smoothing needs an earth-frame filter method"),
+             (["--param", "delta_q=1"], "unknown parameter 'delta_q'"),
+             (["--param", "stationary=2"], "stationary must be 0 or 1"),
+             (["--param", "rest_time=0"], "rest_time must be a finite positive number"),
+             (["--param", "tau_heading=-1"], "tau_heading must be a finite positive number"),
+             (["--latency", "1"], "latency must be a finite number of seconds"))
+    for options, message in cases:
+        for command in (["estimate", *absent, "--out", str(tmp_path / "out")],
+                        ["evaluate", *absent],
+                        ["plot", absent[0], "--out", str(tmp_path / "p.png")]):
+            if command[0] == "plot" and "--method" not in options:
+                command += ["--method", "wiener"]
+            assert main([*command, *options]) == 2, (command, options)
+            err = capsys.readouterr().err
+            assert message in err and "a.csv" not in err, (command, options, err)
+    assert not (tmp_path / "out").exists()
+
+
 def test_console_entry_point_reports_errors_without_traceback(tmp_path):
     proc = subprocess.run([sys.executable, "-m", "systems.cli", "estimate", str(tmp_path / "none.csv"),
                            "--out", str(tmp_path / "o.csv")], capture_output=True, text=True)
