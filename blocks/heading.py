@@ -22,8 +22,12 @@ room or building), no longer locks the magnetometer out for good. Turning cannot
 disturbance fixed in the room (a monitor beside a resting sensor) from the earth's field:
 after mag_new_time of turning there it is taken too, and left the same way.
 Before all this the field is freed of a hard-iron offset, a field fixed to the sensor,
-when a sphere fit proves one (blocks.hard_iron; its parameters are listed here too).
-Inclination is untouched: the correction turns about the vertical only.
+when a sphere fit proves one (blocks.hard_iron; its parameters are listed here too), and
+a magnetometer that trails the gyro by mag_delay seconds (its own filters and sample
+time) is read against the orientation it had then, q turned back by mag_delay at the
+rate of the last step: a field seen late in a fast turn would otherwise show a heading
+error and a dip that changes with the turn (which the guard refuses). Inclination is
+untouched: the correction turns about the vertical only.
 """
 from __future__ import annotations
 
@@ -35,7 +39,7 @@ from . import hard_iron
 from .hard_iron import hard_iron_step, pull
 from .jit import kernel
 from .methods import Param, resolve_params
-from .quaternion import quat_multiply, quat_rotate
+from .quaternion import quat_multiply, quat_rotate, rotvec_quat
 from .stepper_system import sample_system
 
 PARAMS = (
@@ -46,16 +50,19 @@ PARAMS = (
     Param("heading_clip", math.radians(10.0), "rad", "largest heading innovation one sample may use"),
     Param("mag_new_time", 20.0, "s", "how long a field outside the reference's tolerance must stay steady to replace it"),
     Param("mag_new_angle", math.radians(90.0), "rad", "how far the sensor must turn meanwhile (0: no turn)", True),
+    Param("mag_delay", None, "s", "delay of the magnetometer behind the gyro; unset: measured from the recording in "
+          "the batch path (systems.delays.mag_delay), 0 in the FMU and the python-control block", True),
 ) + hard_iron.PARAMS
 STATE_NAMES = (
     "psi_c", "ref_norm", "ref_dip", "seen", "cand_norm", "cand_dip", "cand_n", "cand_dot",
     "cand_q0_w", "cand_q0_x", "cand_q0_y", "cand_q0_z", "steps", "cand_start", "gap",
+    "q_prev_w", "q_prev_x", "q_prev_y", "q_prev_z",
     *(f"hard_iron_{n}" for n in hard_iron.STATE_NAMES),
 )  # see initial_state
 REF_NORM, REF_DIP, SEEN = 1, 2, 3
 CAND_NORM, CAND_DIP, CAND_N, CAND_DOT, CAND_Q0 = 4, 5, 6, 7, 8  # q₀ in 8…11
-STEPS, CAND_START, GAP = 12, 13, 14
-HARD_IRON = slice(15, 15 + hard_iron.STATE_SIZE)  # blocks.hard_iron's state
+STEPS, CAND_START, GAP, Q_PREV = 12, 13, 14, 15  # the last step's orientation in 15…18
+HARD_IRON = slice(19, 19 + hard_iron.STATE_SIZE)  # blocks.hard_iron's state
 HARD_IRON_OFFSET = HARD_IRON.start + hard_iron.OFFSET.start  # its offset estimate in 3 entries from here
 
 
@@ -66,12 +73,13 @@ def resolve(overrides=None) -> dict:
 def coefficients(params, Ts: float) -> np.ndarray:
     """[Ts/tau_heading, Ts/tau_reference, mag_norm_tol, mag_dip_tol, heading_clip, steps a
     new field must stay steady, cos(mag_new_angle/2), 1 − exp(−Ts/tau_heading),
-    1 − exp(−Ts/tau_reference), then blocks.hard_iron's coefficients]. Ts is the step
-    (IMU sample) time."""
+    1 − exp(−Ts/tau_reference), mag_delay/Ts (mag_delay unset: 0), then blocks.hard_iron's
+    coefficients]. Ts is the step (IMU sample) time."""
     return np.concatenate([[Ts / params["tau_heading"], Ts / params["tau_reference"],
                             params["mag_norm_tol"], params["mag_dip_tol"], params["heading_clip"],
                             params["mag_new_time"] / Ts, math.cos(0.5 * params["mag_new_angle"]),
-                            1.0 - math.exp(-Ts / params["tau_heading"]), 1.0 - math.exp(-Ts / params["tau_reference"])],
+                            1.0 - math.exp(-Ts / params["tau_heading"]), 1.0 - math.exp(-Ts / params["tau_reference"]),
+                            (params["mag_delay"] or 0.0) / Ts],
                            hard_iron.coefficients(params, Ts)])
 
 
@@ -80,7 +88,7 @@ def initial_state() -> np.ndarray:
     began, candidate norm, candidate dip (rad), field samples in the candidate, smallest
     |q·q₀| since the candidate began, q₀ (4, the orientation then), steps since the
     start-up began, the step the candidate began at, steps since the last field sample,
-    then blocks.hard_iron's state]."""
+    the last step's orientation (4; 0: none yet), then blocks.hard_iron's state]."""
     state = np.zeros(len(STATE_NAMES))
     state[CAND_DOT] = 1.0
     return state
@@ -149,25 +157,46 @@ def _field_sample(state, coef, q, m, horizontal):
 
 
 @kernel(inline=True)
+def turned_back(q, q_prev, steps):
+    """q turned back in the sensor frame by steps (a fraction of) the rotation from q_prev
+    to q: the orientation steps sample times ago at the last step's rate."""
+    d = quat_multiply((q_prev[0], -q_prev[1], -q_prev[2], -q_prev[3]), q)
+    if d[0] < 0.0:
+        d = (-d[0], -d[1], -d[2], -d[3])
+    s = math.sqrt(d[1] * d[1] + d[2] * d[2] + d[3] * d[3])
+    if s == 0.0:
+        return q
+    k = -2.0 * math.atan2(s, d[0]) * steps / s  # rotation vector back over steps: k·(d_x, d_y, d_z)
+    return quat_multiply(q, rotvec_quat(k * d[1], k * d[2], k * d[3]))
+
+
+@kernel(inline=True)
 def heading_step(state, coef, q, m_sensor):
     """One step: (q turned by the updated ψ_c, whether the field was used). q is the
     attitude filter's orientation (4-tuple), m_sensor the field (3-tuple; a NaN: no field
     sample this step, a slower magnetometer); state in place. Times count steps, so a
-    slower magnetometer keeps the time constants in seconds."""
+    slower magnetometer keeps the time constants in seconds. The field is read against q
+    turned back by mag_delay (coef[9], in steps)."""
     state[GAP] += 1.0
     if state[SEEN] > 0.0:
         state[STEPS] += 1.0
     ok = False
     n2 = m_sensor[0] * m_sensor[0] + m_sensor[1] * m_sensor[1] + m_sensor[2] * m_sensor[2]
     if math.isfinite(n2) and n2 > 0.0:  # a field sample (not NaN: missing, not all 0: none)
-        m_sensor, proven = hard_iron_step(state[HARD_IRON], coef[9:], m_sensor, state[GAP], coef[2], coef[5])
+        m_sensor, proven = hard_iron_step(state[HARD_IRON], coef[10:], m_sensor, state[GAP], coef[2], coef[5])
         if proven:  # a field freed of (or back without) an offset: start afresh from it
             state[SEEN] = 0.0
+        q_field = q
+        q_prev = (state[Q_PREV], state[Q_PREV + 1], state[Q_PREV + 2], state[Q_PREV + 3])
+        if coef[9] != 0.0 and abs(q_prev[0]) + abs(q_prev[1]) + abs(q_prev[2]) + abs(q_prev[3]) > 0.0:
+            q_field = turned_back(q, q_prev, coef[9])
         half = 0.5 * state[0]
-        m = quat_rotate(quat_multiply((math.cos(half), 0.0, 0.0, math.sin(half)), q), m_sensor)
+        m = quat_rotate(quat_multiply((math.cos(half), 0.0, 0.0, math.sin(half)), q_field), m_sensor)
         horizontal = math.sqrt(m[0] * m[0] + m[1] * m[1])
         if horizontal > 0.0:  # a field with a heading
             ok = _field_sample(state, coef, q, m, horizontal)
+    for i in range(4):
+        state[Q_PREV + i] = q[i]
     if abs(state[0]) > math.pi:
         state[0] = math.atan2(math.sin(state[0]), math.cos(state[0]))
     half = 0.5 * state[0]

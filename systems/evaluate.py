@@ -8,13 +8,13 @@ import sys
 from dataclasses import replace
 
 import numpy as np
-from scipy.optimize import minimize_scalar
 from scipy.spatial.transform import Rotation
 
 from blocks.timing import carry_forward_rows, interval_means
 
 from .batch import check_options, estimate
 from .compare import peer_quaternions
+from .delays import best_shift
 from .errors import quaternion_errors
 from .recording import Recording, print_notes, read_recording
 
@@ -36,7 +36,7 @@ def imu_latency(rec: Recording) -> float | None:
     """The IMU's latency behind its reference (s, in blocks.timing's convention): the
     shift of the reference's mean rate over each sample time that best matches the gyro,
     least squares over the movement phase (at most LATENCY_SAMPLES of it) within
-    ±LATENCY_SEARCH_S: a grid of at most 201 shifts, then a bounded search around the best.
+    ±LATENCY_SEARCH_S (systems.delays.best_shift).
     None where the reference gives fewer than a second of rates or the best shift lies at
     the search's edge."""
     ok = np.isfinite(rec.quat_ref).all(axis=1)
@@ -54,14 +54,8 @@ def imu_latency(rec: Recording) -> float | None:
         shifted = np.column_stack([np.interp(k - lag, index, rate[:, i]) for i in range(3)])
         return float(np.nanmean(np.sum((gyr - shifted) ** 2, axis=1)))
 
-    reach = LATENCY_SEARCH_S * rec.fs
-    grid = np.linspace(-reach, reach, 2 * int(min(reach, 100)) + 1)  # steps of a sample or more
-    best = int(np.argmin([mismatch(lag) for lag in grid]))
-    if best in (0, len(grid) - 1):
-        return None
-    step = grid[1] - grid[0]
-    return float(minimize_scalar(mismatch, bounds=(grid[best] - step, grid[best] + step), method="bounded",
-                                 options={"xatol": 1e-3}).x) / rec.fs
+    lag = best_shift(mismatch, LATENCY_SEARCH_S * rec.fs)
+    return None if lag is None else lag / rec.fs
 
 
 def evaluate_recording(rec: Recording, method: str = "wiener", params=None, offline: bool = False,

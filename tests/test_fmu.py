@@ -98,16 +98,20 @@ def test_estimator_fmu_equals_the_batch_path(fmu_dir, recording, method, latency
 
 
 def test_estimator_fmu_heading_from_its_magnetometer_inputs_equals_the_batch_path(fmu_dir):
+    """With the magnetometer's delay as a parameter (the batch path measures it when not
+    given; the FMU cannot, so both are told): the FMU is the batch path."""
     motion = profile("sine_rotation").motion({"inclination_deg": 20.0}).generate(20.0, FS)
     gyr, acc = ImuModel(delta_n=math.radians(0.05), gyr_offset=(0.0, 0.0, 0.01)).apply(motion, seed=3)
-    mag = motion.mag.copy()
+    mag = np.vstack([motion.mag[:2], motion.mag[:-2]])  # 20 ms behind the gyro
     mag[1::3] = np.nan  # a magnetometer at a third of the rate: NaN between its samples
-    runner = FmuRunner(fmu_dir / "AttitudeEstimator.fmu", {"gyro_offset": "off"}, INPUTS + ["mag_x", "mag_y", "mag_z"],
-                       OUTPUTS)
+    params = {"mag_delay": 0.02}
+    runner = FmuRunner(fmu_dir / "AttitudeEstimator.fmu", {"gyro_offset": "off", **params},
+                       INPUTS + ["mag_x", "mag_y", "mag_z"], OUTPUTS)
     out, _ = runner.run(np.hstack([gyr, acc, mag]), 1 / FS)
     runner.close()
-    ref = estimate(gyr, acc, FS, mag=mag)
+    ref = estimate(gyr, acc, FS, mag=mag, params=params)
     assert np.abs(out[:, :4] - ref.quat).max() < 1e-9
+    assert np.abs(out[:, :4] - estimate(gyr, acc, FS, mag=mag, params={"mag_delay": 0.0}).quat).max() > 1e-4
     assert not ref.mag_accepted[1::3].any() and ref.mag_accepted[::3].mean() > 0.9
     # the samples without a field keep the heading correction: the output stays smooth
     print("largest step of the output quaternion", np.abs(np.diff(out[:, :4], axis=0)).max())
@@ -125,7 +129,7 @@ def test_estimator_fmu_reports_the_hard_iron_estimate_of_the_batch_path(fmu_dir)
                        OUTPUTS + ["mag_offset_x", "mag_offset_y", "mag_offset_z"])
     out, _ = runner.run(np.hstack([gyr, acc, mag]), 1 / FS)
     runner.close()
-    ref = estimate(gyr, acc, FS, mag=mag)
+    ref = estimate(gyr, acc, FS, mag=mag, params={"mag_delay": 0.0})  # the FMU's default
     assert np.abs(out[:, :4] - ref.quat).max() < 1e-9
     assert np.abs(out[:, 7:10] - ref.mag_offset).max() < 1e-9
     assert np.abs(out[-1, 7:10] - [15.0, -5.0, 8.0]).max() < 0.5
@@ -158,7 +162,8 @@ def test_estimator_fmu_passes_gyro_offset_and_heading_parameters_on(fmu_dir):
     latency stage works on the offset-free gyro and the magnetometer's heading."""
     motion = profile("sine_rotation").motion({"inclination_deg": 20.0}).generate(20.0, FS)
     gyr, acc = ImuModel(delta_n=math.radians(0.05), gyr_offset=(0.0, 0.0, 0.01)).apply(motion, seed=3)
-    params = {"delta_n": math.radians(0.3), "rest_time": 0.5, "tau_heading": 2.0, "mag_cal_time": 0.0}
+    params = {"delta_n": math.radians(0.3), "rest_time": 0.5, "tau_heading": 2.0, "mag_cal_time": 0.0,
+              "mag_delay": 0.01}
     runner = FmuRunner(fmu_dir / "AttitudeEstimator.fmu", {"gyro_offset": "on", "latency": 0.005, **params},
                        INPUTS + ["mag_x", "mag_y", "mag_z"], OUTPUTS + ["gyr_offset_x", "gyr_offset_y", "gyr_offset_z"])
     out, _ = runner.run(np.hstack([gyr, acc, motion.mag]), 1 / FS)
@@ -420,8 +425,10 @@ GYR_SCALE = ((0.002, 0.01, 0.0), (0.0, -0.003, 0.0), (-0.005, 0.0, 0.004))  # sc
 def _batch_pipeline(duration, seed_motion, seed_imu, delta_n, method="wiener", latency=0.0, compensated=0.0):
     motion = profile("human").motion().generate(duration, FS, seed_motion)
     gyr, acc = ImuModel(delta_n=delta_n, gyr_scale=GYR_SCALE, latency=latency).apply(motion, seed_imu)
-    # the sensor passes the field on; the estimator FMU's default estimates the gyro offset
-    return motion, estimate(gyr, acc, FS, method, mag=motion.mag, gyro_offset=True, latency=compensated)
+    # the sensor passes the field on; the estimator FMU's defaults estimate the gyro offset
+    # and take the magnetometer as on time
+    return motion, estimate(gyr, acc, FS, method, {"mag_delay": 0.0}, mag=motion.mag, gyro_offset=True,
+                            latency=compensated)
 
 
 @pytest.mark.parametrize("method", sorted(METHODS))

@@ -1,0 +1,104 @@
+"""Delays between streams, measured from the data: the shift of one stream against another
+that fits best, found on a grid and refined by a bounded search. Used for the IMU's delay
+behind an optical reference (systems.evaluate.imu_latency) and the magnetometer's delay
+behind the gyro (mag_delay)."""
+from __future__ import annotations
+
+import numpy as np
+from scipy.optimize import minimize_scalar
+
+from blocks.jit import kernel
+from blocks.quaternion import integrate_rates, quat_matrix, quat_multiply, quat_rotate, rotvec_quat
+
+MAX_GRID = 100  # at most this many grid steps either way (steps of a sample or more)
+MAG_DELAY_REACH_S = 0.1  # mag_delay looks this far either way
+MAG_SPAN_S = 0.25  # the field is carried by the gyro over spans of about this long
+MAG_TURN = 0.05  # rad: spans over which the sensor turns less carry no delay
+MAG_MIN_TURNING_S = 5.0  # s of turning spans below which no delay is measured
+MAG_MAX_SPANS = 50_000  # at most this many spans, evenly spread, enter the fit
+MAG_OUTLIER = 5.0  # spans whose residual at no delay exceeds this many times the median are left out
+
+
+def best_shift(mismatch, reach: float) -> float | None:
+    """The shift (samples, within ±reach) that minimises mismatch(shift): a grid of at most
+    2·MAX_GRID + 1 shifts, then a bounded search between the best one's neighbours. None
+    where the best shift lies at the grid's edge (the delay is beyond reach, or there is none
+    to find)."""
+    grid = np.linspace(-reach, reach, 2 * int(min(reach, MAX_GRID)) + 1)
+    best = int(np.argmin([mismatch(shift) for shift in grid]))
+    if best in (0, len(grid) - 1):
+        return None
+    step = grid[1] - grid[0]
+    return float(minimize_scalar(mismatch, bounds=(grid[best] - step, grid[best] + step), method="bounded",
+                                 options={"xatol": 1e-3}).x)
+
+
+@kernel()
+def carry_spans(quat, gyr, Ts, x0, x1, m0, back, matrices):
+    """Per span j: back[j] = R_Δᵀ·m0[j] and matrices[j] = R_Δᵀ, R_Δ the sensor's turn from
+    the fractional sample index x0[j] to x1[j] (held at the ends). quat[k]: the sensor at
+    t_k integrated from gyr (rad/s, over Ts s each); between samples k and k + 1 it turns at
+    gyro sample k + 1's rate."""
+    last = quat.shape[0] - 1
+    for j in range(x0.shape[0]):
+        ends = []
+        for x in (x0[j], x1[j]):
+            x = min(max(x, 0.0), float(last))
+            k = min(int(x), last - 1)
+            f = (x - k) * Ts
+            ends.append(quat_multiply((quat[k, 0], quat[k, 1], quat[k, 2], quat[k, 3]),
+                                      rotvec_quat(f * gyr[k + 1, 0], f * gyr[k + 1, 1], f * gyr[k + 1, 2])))
+        q0, q1 = ends[0], ends[1]
+        turn_back = quat_multiply((q1[0], -q1[1], -q1[2], -q1[3]), q0)  # R_Δᵀ = q1⁻¹ ⊗ q0
+        v = quat_rotate(turn_back, (m0[j, 0], m0[j, 1], m0[j, 2]))
+        R = quat_matrix(turn_back)
+        for i in range(3):
+            back[j, i] = v[i]
+            for c in range(3):
+                matrices[j, i, c] = R[3 * i + c]
+
+
+def mag_delay(gyr, mag, fs: float) -> float | None:
+    """The magnetometer's delay behind the gyro (s), from the IMU's own data: a homogeneous
+    field seen by a turning sensor is carried from one sample to the next by the gyro's
+    rotation, m₁ − b = R_Δᵀ·(m₀ − b), b a hard-iron offset. Over spans of about MAG_SPAN_S
+    between the field's own samples (a row with a NaN is a missing sample) that carry is
+    compared with the field, the gyro's rotation taken over the span shifted by the delay
+    and b fitted by least squares at each shift. Spans over which the sensor turns less
+    than MAG_TURN, and those a disturbance passes (residual above MAG_OUTLIER times the
+    median at no delay), are left out. gyr N×3 rad/s (sample k the mean rate before it),
+    mag N×3 in any unit. None where fewer than MAG_MIN_TURNING_S seconds of turning spans
+    remain or the best delay lies beyond ±MAG_DELAY_REACH_S."""
+    gyr, mag = np.asarray(gyr, dtype=float), np.asarray(mag, dtype=float)
+    sampled = np.flatnonzero(np.isfinite(mag).all(axis=1))
+    if len(sampled) < 2:
+        return None
+    spacing = float(np.median(np.diff(sampled)))
+    stride = max(1, int(round(MAG_SPAN_S * fs / spacing)))
+    k0, k1 = sampled[:-stride], sampled[stride:]
+    quat = np.empty((len(gyr), 4))
+    integrate_rates(np.ascontiguousarray(gyr), 1.0 / fs, quat)  # quat[k]: the sensor at t_k
+
+    def carried(shift, keep):
+        """(R_Δᵀ·m₀, R_Δᵀ) over each span of keep, the gyro shifted by shift samples."""
+        back, matrices = np.empty((len(keep), 3)), np.empty((len(keep), 3, 3))
+        carry_spans(quat, gyr, 1.0 / fs, k0[keep] - shift, k1[keep] - shift, mag[k0[keep]], back, matrices)
+        return back, matrices
+
+    def residuals(shift, keep):
+        back, matrices = carried(shift, keep)
+        y = mag[k1[keep]] - back  # = (I − R_Δᵀ)·b
+        A = np.eye(3) - matrices
+        b = np.linalg.solve(np.einsum("nij,nik->jk", A, A), np.einsum("nij,ni->j", A, y))  # normal equations
+        return y - A @ b
+
+    # the angle turned over a span, from the trace of R_Δᵀ
+    turn = np.arccos(np.clip((np.trace(carried(0.0, np.arange(len(k0)))[1], axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0))
+    keep = np.flatnonzero(turn >= MAG_TURN)
+    keep = keep[::-(-len(keep) // MAG_MAX_SPANS)] if len(keep) else keep
+    if len(keep) * spacing / fs < MAG_MIN_TURNING_S:
+        return None
+    error = np.sum(residuals(0.0, keep) ** 2, axis=1)
+    keep = keep[error <= MAG_OUTLIER * np.median(error)]
+    shift = best_shift(lambda s: float(np.mean(np.sum(residuals(s, keep) ** 2, axis=1))), MAG_DELAY_REACH_S * fs)
+    return None if shift is None else shift / fs
