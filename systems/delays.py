@@ -10,21 +10,22 @@ from scipy.optimize import minimize_scalar
 from blocks.jit import kernel
 from blocks.quaternion import integrate_rates, quat_matrix, quat_multiply, quat_rotate, rotvec_quat
 
-MAX_GRID = 100  # at most this many grid steps either way (steps of a sample or more)
+MAX_GRID = 100  # by default at most this many grid steps either way (steps of a sample or more)
 MAG_DELAY_REACH_S = 0.1  # mag_delay looks this far either way
 MAG_SPAN_S = 0.25  # the field is carried by the gyro over spans of about this long
 MAG_TURN = 0.05  # rad: spans over which the sensor turns less carry no delay
 MAG_MIN_TURNING_S = 5.0  # s of turning spans below which no delay is measured
-MAG_MAX_SPANS = 50_000  # at most this many spans, evenly spread, enter the fit
+MAG_MAX_SPANS = 2_000  # at most this many spans, evenly spread, enter the fit
+MAG_GRID = 10  # grid steps either way (10 ms for MAG_DELAY_REACH_S): the fit's mismatch is smooth in the shift
 MAG_OUTLIER = 5.0  # spans whose residual at no delay exceeds this many times the median are left out
 
 
-def best_shift(mismatch, reach: float) -> float | None:
+def best_shift(mismatch, reach: float, steps: int = MAX_GRID) -> float | None:
     """The shift (samples, within ±reach) that minimises mismatch(shift): a grid of at most
-    2·MAX_GRID + 1 shifts, then a bounded search between the best one's neighbours. None
-    where the best shift lies at the grid's edge (the delay is beyond reach, or there is none
-    to find)."""
-    grid = np.linspace(-reach, reach, 2 * int(min(reach, MAX_GRID)) + 1)
+    2·steps + 1 shifts (a sample apart or more), then a bounded search between the best
+    one's neighbours. None where the best shift lies at the grid's edge (the delay is
+    beyond reach, or there is none to find)."""
+    grid = np.linspace(-reach, reach, 2 * int(min(reach, steps)) + 1)
     best = int(np.argmin([mismatch(shift) for shift in grid]))
     if best in (0, len(grid) - 1):
         return None
@@ -62,13 +63,15 @@ def mag_delay(gyr, mag, fs: float) -> float | None:
     """The magnetometer's delay behind the gyro (s), from the IMU's own data: a homogeneous
     field seen by a turning sensor is carried from one sample to the next by the gyro's
     rotation, m₁ − b = R_Δᵀ·(m₀ − b), b a hard-iron offset. Over spans of about MAG_SPAN_S
-    between the field's own samples (a row with a NaN is a missing sample) that carry is
+    between the field's own samples (a row with a NaN is a missing sample; at most
+    MAG_MAX_SPANS spans, evenly spread over the recording) that carry is
     compared with the field, the gyro's rotation taken over the span shifted by the delay
     and b fitted by least squares at each shift. Spans over which the sensor turns less
     than MAG_TURN, and those a disturbance passes (residual above MAG_OUTLIER times the
     median at no delay), are left out. gyr N×3 rad/s (sample k the mean rate before it),
     mag N×3 in any unit. None where fewer than MAG_MIN_TURNING_S seconds of turning spans
-    remain or the best delay lies beyond ±MAG_DELAY_REACH_S."""
+    remain (or the recording is shorter than a span) or the best delay lies beyond
+    ±MAG_DELAY_REACH_S."""
     gyr, mag = np.asarray(gyr, dtype=float), np.asarray(mag, dtype=float)
     sampled = np.flatnonzero(np.isfinite(mag).all(axis=1))
     if len(sampled) < 2:
@@ -76,6 +79,10 @@ def mag_delay(gyr, mag, fs: float) -> float | None:
     spacing = float(np.median(np.diff(sampled)))
     stride = max(1, int(round(MAG_SPAN_S * fs / spacing)))
     k0, k1 = sampled[:-stride], sampled[stride:]
+    if len(k0) == 0:  # shorter than a span
+        return None
+    spread = -(-len(k0) // MAG_MAX_SPANS)
+    k0, k1 = k0[::spread], k1[::spread]
     quat = np.empty((len(gyr), 4))
     integrate_rates(np.ascontiguousarray(gyr), 1.0 / fs, quat)  # quat[k]: the sensor at t_k
 
@@ -95,10 +102,10 @@ def mag_delay(gyr, mag, fs: float) -> float | None:
     # the angle turned over a span, from the trace of R_Δᵀ
     turn = np.arccos(np.clip((np.trace(carried(0.0, np.arange(len(k0)))[1], axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0))
     keep = np.flatnonzero(turn >= MAG_TURN)
-    keep = keep[::-(-len(keep) // MAG_MAX_SPANS)] if len(keep) else keep
-    if len(keep) * spacing / fs < MAG_MIN_TURNING_S:
+    if len(keep) * spread * spacing / fs < MAG_MIN_TURNING_S:
         return None
     error = np.sum(residuals(0.0, keep) ** 2, axis=1)
     keep = keep[error <= MAG_OUTLIER * np.median(error)]
-    shift = best_shift(lambda s: float(np.mean(np.sum(residuals(s, keep) ** 2, axis=1))), MAG_DELAY_REACH_S * fs)
+    shift = best_shift(lambda s: float(np.mean(np.sum(residuals(s, keep) ** 2, axis=1))), MAG_DELAY_REACH_S * fs,
+                       MAG_GRID)
     return None if shift is None else shift / fs

@@ -45,6 +45,7 @@ def test_the_delay_is_measured_from_the_imu_alone():
     assert abs(measured - DELAY_STEPS / FS) < 1e-3
     assert abs(mag_delay(gyr, on_time, FS)) < 1e-3
     assert mag_delay(np.zeros_like(gyr), on_time, FS) is None  # a still sensor shows no delay
+    assert mag_delay(gyr[:20], on_time[:20], FS) is None  # nor a recording shorter than a span
 
 
 def test_the_heading_allows_for_the_delay_it_measured():
