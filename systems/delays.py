@@ -16,6 +16,8 @@ MAG_SPAN_S = 0.25  # the field is carried by the gyro over spans of about this l
 MAG_TURN = 0.05  # rad: spans over which the sensor turns less carry no delay
 MAG_MIN_TURNING_S = 5.0  # s of turning spans below which no delay is measured
 MAG_MAX_SPANS = 2_000  # at most this many spans, evenly spread, enter the fit
+MAG_DELAY_SIGMAS = 3.0  # a delay is reported only this many standard errors or more from 0
+MAG_CURVATURE_S = 1e-3  # s: the step over which the fit's curvature in the delay is taken
 MAG_GRID = 10  # grid steps either way (10 ms for MAG_DELAY_REACH_S): the fit's mismatch is smooth in the shift
 MAG_OUTLIER = 5.0  # spans whose residual at no delay exceeds this many times the median are left out
 
@@ -70,8 +72,10 @@ def mag_delay(gyr, mag, fs: float) -> float | None:
     than MAG_TURN, and those a disturbance passes (residual above MAG_OUTLIER times the
     median at no delay), are left out. gyr N×3 rad/s (sample k the mean rate before it),
     mag N×3 in any unit. None where fewer than MAG_MIN_TURNING_S seconds of turning spans
-    remain (or the recording is shorter than a span) or the best delay lies beyond
-    ±MAG_DELAY_REACH_S."""
+    remain (or the recording is shorter than a span), where the best delay lies beyond
+    ±MAG_DELAY_REACH_S, or where it lies within MAG_DELAY_SIGMAS standard errors (from the
+    fit's curvature) of 0: a delay the data do not show (a sensor that turns too little for
+    the field's noise, or none)."""
     gyr, mag = np.asarray(gyr, dtype=float), np.asarray(mag, dtype=float)
     sampled = np.flatnonzero(np.isfinite(mag).all(axis=1))
     if len(sampled) < 2:
@@ -106,6 +110,19 @@ def mag_delay(gyr, mag, fs: float) -> float | None:
         return None
     error = np.sum(residuals(0.0, keep) ** 2, axis=1)
     keep = keep[error <= MAG_OUTLIER * np.median(error)]
-    shift = best_shift(lambda s: float(np.mean(np.sum(residuals(s, keep) ** 2, axis=1))), MAG_DELAY_REACH_S * fs,
-                       MAG_GRID)
-    return None if shift is None else shift / fs
+    def mismatch(shift):
+        return float(np.mean(np.sum(residuals(shift, keep) ** 2, axis=1)))
+
+    shift = best_shift(mismatch, MAG_DELAY_REACH_S * fs, MAG_GRID)
+    if shift is None:
+        return None
+    # its standard error: mismatch ≈ M₀ + c·(s − ŝ)² with c the mean square of the residuals'
+    # derivative in s, whose 3·N components (N spans, fewer where they overlap) each carry
+    # noise of variance M₀/3
+    h = MAG_CURVATURE_S * fs
+    m0 = mismatch(shift)
+    c = (mismatch(shift + h) + mismatch(shift - h) - 2.0 * m0) / (2.0 * h * h)
+    independent = len(keep) * min(1.0, spread / stride)
+    if c <= 0.0 or shift * shift < MAG_DELAY_SIGMAS**2 * m0 / (3.0 * independent * c):
+        return None
+    return shift / fs
