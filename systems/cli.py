@@ -309,9 +309,16 @@ def _estimate_one(args, path, out, prefix: str) -> None:
         sampled = np.isfinite(rec.mag).all(axis=1)  # rows where a slower magnetometer has a sample
         print(f"attitude: {prefix}magnetometer samples used for heading "
               f"{100 * result.mag_accepted[sampled].mean():.0f} %, hard-iron offset at the end "
-              f"({', '.join(f'{v:.1f}' for v in result.mag_offset[-1])}) µT; its delay behind the gyro "
-              f"{1e3 * result.mag_delay:.1f} ms" + (" (measured; --param mag_delay=S sets it)"
-                                                   if result.mag_delay_measured else ""), file=sys.stderr)
+              f"({', '.join(f'{v:.1f}' for v in result.mag_offset[-1])}) µT; {_mag_delay_text(result)}",
+              file=sys.stderr)
+
+
+def _mag_delay_text(result) -> str:
+    if not result.mag_delay_measured:
+        return f"its delay behind the gyro {1e3 * result.mag_delay:.1f} ms (given)"
+    if result.mag_delay == 0.0:
+        return "no delay behind the gyro that the recording shows (--param mag_delay=S sets one)"
+    return f"its delay behind the gyro {1e3 * result.mag_delay:.1f} ms (measured; --param mag_delay=S sets it)"
 
 
 def cmd_evaluate(args) -> int:

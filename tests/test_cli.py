@@ -150,7 +150,14 @@ def test_the_share_of_magnetometer_samples_used_counts_the_samples_there_are(tmp
     field[np.arange(len(field)) % 4 != 0] = np.nan
     _write_csv(tmp_path / "in.csv", {**_imu_columns(gyr, acc), **{f"mag_{a}": field[:, i] for i, a in enumerate("xyz")}})
     assert main(["estimate", str(tmp_path / "in.csv"), "--out", str(tmp_path / "out.csv")]) == 0
-    assert "magnetometer samples used for heading 100 %" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "magnetometer samples used for heading 100 %" in err
+    assert "no delay behind the gyro that the recording shows" in err  # a magnetometer on time
+    late = np.vstack([field[:2], field[:-2]])  # 20 ms late, given
+    _write_csv(tmp_path / "late.csv", {**_imu_columns(gyr, acc), **{f"mag_{a}": late[:, i] for i, a in enumerate("xyz")}})
+    assert main(["estimate", str(tmp_path / "late.csv"), "--out", str(tmp_path / "out.csv"),
+                 "--param", "mag_delay=0.02"]) == 0
+    assert "its delay behind the gyro 20.0 ms (given)" in capsys.readouterr().err
 
 
 def test_estimate_reads_a_broad_mat_recording(tmp_path, imu, capsys):

@@ -17,9 +17,10 @@ HARD_IRON_UT = (12.0, -4.0, 7.0)
 
 
 def _fast_turns(duration=120.0, hard_iron=HARD_IRON_UT):
-    """Turning at up to 3 rad/s about each axis (heading ±86°, tilt ±34°, ±29°): (motion, gyr, acc, the field
-    as a magnetometer on time and one DELAY_STEPS behind the gyro see it, each with 0.5 µT
-    noise and the hard-iron offset (µT), sampled at a third of FS: NaN between its samples)."""
+    """Turning at up to 3 rad/s about each axis (heading ±86°, tilt ±34° and ±29°):
+    (motion, gyr, acc, the field as a magnetometer on time and one DELAY_STEPS behind the
+    gyro see it, each with 0.5 µT noise and the hard-iron offset (µT), sampled at a third
+    of FS: NaN between its samples)."""
     def angles(t):
         return np.column_stack([1.5 * np.sin(2.0 * t), 0.6 * np.sin(5.0 * t), 0.5 * np.sin(6.0 * t)])
     turns = ClosedFormMotion("turns", lambda t: Rotation.from_euler("ZYX", angles(t)), lambda t: np.zeros((len(t), 3)))
