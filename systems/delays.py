@@ -8,7 +8,7 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from blocks.jit import kernel
-from blocks.quaternion import integrate_rates, quat_matrix, quat_multiply, quat_rotate, rotvec_quat
+from blocks.quaternion import integrate_rates, quat_matrix, quat_multiply, rotvec_quat
 
 MAX_GRID = 100  # by default at most this many grid steps either way (steps of a sample or more)
 MAG_DELAY_REACH_S = 0.1  # mag_delay looks this far either way
@@ -37,9 +37,9 @@ def best_shift(mismatch, reach: float, steps: int = MAX_GRID) -> float | None:
 
 
 @kernel()
-def carry_spans(quat, gyr, Ts, x0, x1, m0, back, matrices):
-    """Per span j: back[j] = R_Δᵀ·m0[j] and matrices[j] = R_Δᵀ, R_Δ the sensor's turn from
-    the fractional sample index x0[j] to x1[j] (held at the ends). quat[k]: the sensor at
+def carry_spans(quat, gyr, Ts, x0, x1, matrices):
+    """Per span j: matrices[j] = R_Δᵀ, R_Δ the sensor's turn from the fractional sample
+    index x0[j] to x1[j] (held at the ends). quat[k]: the sensor at
     t_k integrated from gyr (rad/s, over Ts s each); between samples k and k + 1 it turns at
     gyro sample k + 1's rate."""
     last = quat.shape[0] - 1
@@ -53,10 +53,8 @@ def carry_spans(quat, gyr, Ts, x0, x1, m0, back, matrices):
                                       rotvec_quat(f * gyr[k + 1, 0], f * gyr[k + 1, 1], f * gyr[k + 1, 2])))
         q0, q1 = ends[0], ends[1]
         turn_back = quat_multiply((q1[0], -q1[1], -q1[2], -q1[3]), q0)  # R_Δᵀ = q1⁻¹ ⊗ q0
-        v = quat_rotate(turn_back, (m0[j, 0], m0[j, 1], m0[j, 2]))
         R = quat_matrix(turn_back)
         for i in range(3):
-            back[j, i] = v[i]
             for c in range(3):
                 matrices[j, i, c] = R[3 * i + c]
 
@@ -91,20 +89,20 @@ def mag_delay(gyr, mag, fs: float) -> float | None:
     integrate_rates(np.ascontiguousarray(gyr), 1.0 / fs, quat)  # quat[k]: the sensor at t_k
 
     def carried(shift, keep):
-        """(R_Δᵀ·m₀, R_Δᵀ) over each span of keep, the gyro shifted by shift samples."""
-        back, matrices = np.empty((len(keep), 3)), np.empty((len(keep), 3, 3))
-        carry_spans(quat, gyr, 1.0 / fs, k0[keep] - shift, k1[keep] - shift, mag[k0[keep]], back, matrices)
-        return back, matrices
+        """R_Δᵀ over each span of keep, the gyro shifted by shift samples."""
+        matrices = np.empty((len(keep), 3, 3))
+        carry_spans(quat, gyr, 1.0 / fs, k0[keep] - shift, k1[keep] - shift, matrices)
+        return matrices
 
     def residuals(shift, keep):
-        back, matrices = carried(shift, keep)
-        y = mag[k1[keep]] - back  # = (I − R_Δᵀ)·b
+        matrices = carried(shift, keep)
+        y = mag[k1[keep]] - np.einsum("nij,nj->ni", matrices, mag[k0[keep]])  # = (I − R_Δᵀ)·b
         A = np.eye(3) - matrices
         b = np.linalg.solve(np.einsum("nij,nik->jk", A, A), np.einsum("nij,ni->j", A, y))  # normal equations
         return y - A @ b
 
     # the angle turned over a span, from the trace of R_Δᵀ
-    turn = np.arccos(np.clip((np.trace(carried(0.0, np.arange(len(k0)))[1], axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0))
+    turn = np.arccos(np.clip((np.trace(carried(0.0, np.arange(len(k0))), axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0))
     keep = np.flatnonzero(turn >= MAG_TURN)
     if len(keep) * spread * spacing / fs < MAG_MIN_TURNING_S:
         return None
