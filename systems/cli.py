@@ -187,6 +187,15 @@ def build_parser() -> argparse.ArgumentParser:
     cp = sub.add_parser("compare", help="every estimator and the peers vqf, madgwick on every motion profile")
     cp.add_argument("--profile", action="append", help="only this profile (repeatable)")
     cp.add_argument("--json", action="store_true")
+    cp.add_argument("--gyro-noise", type=float, default=0.02, metavar="DEG_S_RTHZ",
+                    help="the simulated gyro's white noise, °/s/√Hz (default 0.02)")
+    cp.add_argument("--acc-noise", type=float, default=0.002, metavar="M_S2_RTHZ",
+                    help="the simulated accelerometer's white noise, m/s²/√Hz (default 0.002)")
+    cp.add_argument("--gyro-scale-error", type=float, default=0.0, metavar="FRACTION",
+                    help="rms of each element of the simulated gyro's scale-factor and misalignment matrix, "
+                         "drawn once (1 = 100 %%; default 0, an ideal scale)")
+    cp.add_argument("--offline", action="store_true",
+                    help="also the smoothers: every earth-frame method offline, and vqf's offline estimate")
 
     bd = sub.add_parser("bode", help="frequency response of a method's filter (tseng: also Tseng Figs. 6-7)")
     bd.add_argument("--method", default="tseng", choices=sorted(m for m in METHODS if METHODS[m].is_sensor_frame))
@@ -422,20 +431,22 @@ def cmd_verify(args) -> int:
 
 
 def cmd_compare(args) -> int:
-    from .compare import compare
+    from .compare import compare, imu_model
     from .motion import profile as known_profile
 
     for name in args.profile or []:
         known_profile(name)  # refuses unknown names
-    result = compare(args.profile)
+    imu = imu_model(args.gyro_noise, args.acc_noise, args.gyro_scale_error)
+    result = compare(args.profile, imu=imu, offline=args.offline)
     if args.json:
         print(json.dumps(result, indent=2))
         return 0
-    print("inclination error, degrees: RMS / max / mean (bias); realistic MEMS noise, default parameters")
+    print(f"inclination error, degrees: RMS / max / mean (bias); default parameters; gyro {args.gyro_noise:g} °/s/√Hz, "
+          f"scale error {args.gyro_scale_error:g}, accelerometer {args.acc_noise:g} m/s²/√Hz")
     for profile, rows in result["profiles"].items():
         print(f"\n{profile}")
         for method, r in rows.items():
-            print(f"  {method:>15} {r['rms_deg']:8.3f} {r['max_deg']:8.3f} {r['mean_deg']:9.4f}")
+            print(f"  {method:>19} {r['rms_deg']:8.3f} {r['max_deg']:8.3f} {r['mean_deg']:9.4f}")
     return 0
 
 

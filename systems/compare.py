@@ -1,5 +1,6 @@
 """`attitude compare`: every estimator and the peers vqf and ahrs' Madgwick on every
-motion profile, on the same samples with realistic sensor noise."""
+motion profile, on the same samples with realistic sensor noise (or an IMU of the
+caller's figures, see imu_model)."""
 from __future__ import annotations
 
 import math
@@ -16,12 +17,27 @@ from .motion import PROFILES
 from .sensor_model import ImuModel
 
 FS = 100.0  # Hz
-# a MEMS IMU: gyro 0.02 °/s/√Hz, accelerometer 200 µg/√Hz, no offsets
-IMU = ImuModel(delta_n=math.radians(0.02), acc_noise=0.002)
 DURATION_S = {"human": 600.0}  # others: DEFAULT_DURATION_S
 DEFAULT_DURATION_S = 300.0
 SKIP_S = 100.0  # start-up excluded from the statistics (ten time constants of the default Wiener filter)
 PEERS = ("vqf", "madgwick")
+
+
+def imu_model(gyro_noise_dps: float = 0.02, acc_noise: float = 0.002, gyro_scale_error: float = 0.0,
+              seed: int = 0) -> ImuModel:
+    """The compared IMU: gyro white noise gyro_noise_dps (°/s/√Hz), accelerometer white
+    noise acc_noise (m/s²/√Hz) and a scale-factor and misalignment matrix whose elements are
+    drawn normal with rms gyro_scale_error (1 = 100 %) from seed; no offsets."""
+    for what, value, top in (("gyro noise", gyro_noise_dps, math.inf), ("accelerometer noise", acc_noise, math.inf),
+                             ("gyro scale error", gyro_scale_error, 0.5)):
+        if not (math.isfinite(value) and 0.0 <= value < top):
+            raise ValueError(f"{what} must be finite, non-negative{'' if top == math.inf else f' and below {top:g}'}, "
+                             f"got {value!r}")
+    scale = np.random.default_rng((seed, 2)).normal(0.0, gyro_scale_error, (3, 3))
+    return ImuModel(delta_n=math.radians(gyro_noise_dps), acc_noise=acc_noise, gyr_scale=tuple(map(tuple, scale)))
+
+
+IMU = imu_model()  # a MEMS IMU: gyro 0.02 °/s/√Hz, accelerometer 200 µg/√Hz, ideal scale, no offsets
 
 
 def peer_quaternions(name: str, gyr, acc, fs: float) -> np.ndarray:
@@ -34,19 +50,27 @@ def peer_quaternions(name: str, gyr, acc, fs: float) -> np.ndarray:
                            "install them with: pip install 'attitude-fmu[peers]'") from None
     if name == "vqf":
         return vqf.VQF(1.0 / fs).updateBatch(np.ascontiguousarray(gyr), np.ascontiguousarray(acc))["quat6D"]
+    if name == "vqf_offline":
+        return vqf.offlineVQF(np.ascontiguousarray(gyr), np.ascontiguousarray(acc), None, 1.0 / fs)["quat6D"]
     if name == "madgwick":
         return Madgwick(gyr=gyr, acc=acc, frequency=fs).Q
     raise ValueError(f"unknown peer {name!r}")
 
 
-def compare_profile(name: str, methods=None, peers=PEERS, seed: int = 0) -> dict:
-    """{method: {"rms_deg", "max_deg", "mean_deg"}} for one profile."""
+def compare_profile(name: str, methods=None, peers=PEERS, seed: int = 0, imu: ImuModel = IMU,
+                    offline: bool = False) -> dict:
+    """{method: {"rms_deg", "max_deg", "mean_deg"}} for one profile; offline adds the
+    smoothers ("METHOD_offline" for the earth-frame methods, "vqf_offline")."""
     duration = DURATION_S.get(name, DEFAULT_DURATION_S)
     motion = PROFILES[name].motion().generate(duration, FS, seed)
-    gyr, acc = IMU.apply(motion, seed + 1)
+    gyr, acc = imu.apply(motion, seed + 1)
     start = int(SKIP_S * FS)
-    ups = {m: estimate(gyr, acc, FS, m).up for m in (methods or METHODS)}
-    for peer in peers:
+    methods = methods or METHODS
+    ups = {m: estimate(gyr, acc, FS, m).up for m in methods}
+    if offline:
+        ups |= {f"{m}_offline": estimate(gyr, acc, FS, m, offline=True).up
+                for m in methods if METHODS[m].is_sensor_frame}
+    for peer in peers + (("vqf_offline",) if offline and "vqf" in peers else ()):
         q = peer_quaternions(peer, gyr, acc, FS)
         ups[peer] = Rotation.from_quat(q, scalar_first=True).inv().apply([0.0, 0.0, 1.0])
     table = {}
@@ -57,12 +81,13 @@ def compare_profile(name: str, methods=None, peers=PEERS, seed: int = 0) -> dict
     return table
 
 
-def compare(profiles=None, methods=None, peers=PEERS, progress: bool = True) -> dict:
+def compare(profiles=None, methods=None, peers=PEERS, progress: bool = True, imu: ImuModel = IMU,
+            offline: bool = False) -> dict:
     """{"profiles": {profile: {method: {...}}}} over the profiles (default: all)."""
     result = {}
     names = list(profiles or PROFILES)
     for i, name in enumerate(names):
         if progress:
             print(f"compare: {i + 1}/{len(names)} {name}", file=sys.stderr, flush=True)
-        result[name] = compare_profile(name, methods, peers)
+        result[name] = compare_profile(name, methods, peers, imu=imu, offline=offline)
     return {"profiles": result}

@@ -82,7 +82,7 @@ def evaluate_recording(rec: Recording, method: str = "wiener", params=None, offl
     table = {
         label: errors_on_movement(est.quat, rec),
         "vqf": peer(peer_quaternions("vqf", gyr, acc, rec.fs)),
-        "vqf_offline": peer(vqf_module.offlineVQF(gyr, acc, None, 1.0 / rec.fs)["quat6D"]),
+        "vqf_offline": peer(peer_quaternions("vqf_offline", gyr, acc, rec.fs)),
         "madgwick": peer(peer_quaternions("madgwick", gyr, acc, rec.fs)),
     }
     if mag is not None:  # vqf's "no sample" is a zero row, where ours is NaN
