@@ -60,6 +60,7 @@ STATE_NAMES = (
 )
 SUMS, OFFSET, FIT_STEPS, RAW_STEPS, RECENT_FIT, RECENT_RAW, AGE = slice(0, 15), slice(15, 18), 18, 19, 20, 21, 22
 STATE_SIZE = len(STATE_NAMES)
+COEF_SIZE = 6  # see coefficients
 
 
 def coefficients(params, Ts: float) -> np.ndarray:

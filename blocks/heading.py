@@ -24,9 +24,10 @@ after mag_new_time of turning there it is taken too, and left the same way.
 Before all this the field is freed of a hard-iron offset, a field fixed to the sensor,
 when a sphere fit proves one (blocks.hard_iron; its parameters are listed here too), and
 a magnetometer that trails the gyro by mag_delay seconds (its own filters and sample
-time) is read against the orientation it had then, q turned back by mag_delay at the
-rate of the last step: a field seen late in a fast turn would otherwise show a heading
-error and a dip that changes with the turn (which the guard refuses). Inclination is
+time; given, or unset estimated online by blocks.mag_delay) is read against the
+orientation it had then, q turned back by mag_delay at the rate of the last step: a
+field seen late in a fast turn would otherwise show a heading error and a dip that
+changes with the turn (which the guard refuses). Inclination is
 untouched: the correction turns about the vertical only.
 """
 from __future__ import annotations
@@ -35,7 +36,7 @@ import math
 
 import numpy as np
 
-from . import hard_iron
+from . import hard_iron, mag_delay
 from .hard_iron import hard_iron_step, pull
 from .jit import kernel
 from .methods import Param, resolve_params
@@ -50,20 +51,25 @@ PARAMS = (
     Param("heading_clip", math.radians(10.0), "rad", "largest heading innovation one sample may use"),
     Param("mag_new_time", 20.0, "s", "how long a field outside the reference's tolerance must stay steady to replace it"),
     Param("mag_new_angle", math.radians(90.0), "rad", "how far the sensor must turn meanwhile (0: no turn)", True),
-    Param("mag_delay", None, "s", "delay of the magnetometer behind the gyro; unset: measured from the recording in "
-          "the batch path (systems.delays.mag_delay), 0 in the FMU and the python-control block", True),
-) + hard_iron.PARAMS
+    Param("mag_delay", None, "s", "delay of the magnetometer behind the gyro; unset: estimated online "
+          "(blocks.mag_delay; offline, measured from the whole recording, systems.delays.mag_delay)", True),
+) + hard_iron.PARAMS + mag_delay.PARAMS
 STATE_NAMES = (
     "psi_c", "ref_norm", "ref_dip", "seen", "cand_norm", "cand_dip", "cand_n", "cand_dot",
     "cand_q0_w", "cand_q0_x", "cand_q0_y", "cand_q0_z", "steps", "cand_start", "gap",
     "q_prev_w", "q_prev_x", "q_prev_y", "q_prev_z",
     *(f"hard_iron_{n}" for n in hard_iron.STATE_NAMES),
+    *(f"mag_delay_{n}" for n in mag_delay.STATE_NAMES),
 )  # see initial_state
 REF_NORM, REF_DIP, SEEN = 1, 2, 3
 CAND_NORM, CAND_DIP, CAND_N, CAND_DOT, CAND_Q0 = 4, 5, 6, 7, 8  # q₀ in 8…11
 STEPS, CAND_START, GAP, Q_PREV = 12, 13, 14, 15  # the last step's orientation in 15…18
 HARD_IRON = slice(19, 19 + hard_iron.STATE_SIZE)  # blocks.hard_iron's state
 HARD_IRON_OFFSET = HARD_IRON.start + hard_iron.OFFSET.start  # its offset estimate in 3 entries from here
+MAG_DELAY = slice(HARD_IRON.stop, HARD_IRON.stop + mag_delay.STATE_SIZE)  # blocks.mag_delay's state
+MAG_DELAY_IN_USE = MAG_DELAY.start + mag_delay.DELAY  # the online estimate in use (s)
+HARD_IRON_COEF = slice(10, 10 + hard_iron.COEF_SIZE)  # blocks.hard_iron's coefficients
+MAG_DELAY_COEF = slice(HARD_IRON_COEF.stop, HARD_IRON_COEF.stop + mag_delay.COEF_SIZE)
 
 
 def resolve(overrides=None) -> dict:
@@ -73,14 +79,14 @@ def resolve(overrides=None) -> dict:
 def coefficients(params, Ts: float) -> np.ndarray:
     """[Ts/tau_heading, Ts/tau_reference, mag_norm_tol, mag_dip_tol, heading_clip, steps a
     new field must stay steady, cos(mag_new_angle/2), 1 − exp(−Ts/tau_heading),
-    1 − exp(−Ts/tau_reference), mag_delay/Ts (mag_delay unset: 0), then blocks.hard_iron's
-    coefficients]. Ts is the step (IMU sample) time."""
+    1 − exp(−Ts/tau_reference), mag_delay/Ts (mag_delay unset: NaN, estimated online), then
+    blocks.hard_iron's and blocks.mag_delay's coefficients]. Ts is the step (IMU sample) time."""
     return np.concatenate([[Ts / params["tau_heading"], Ts / params["tau_reference"],
                             params["mag_norm_tol"], params["mag_dip_tol"], params["heading_clip"],
                             params["mag_new_time"] / Ts, math.cos(0.5 * params["mag_new_angle"]),
                             1.0 - math.exp(-Ts / params["tau_heading"]), 1.0 - math.exp(-Ts / params["tau_reference"]),
-                            (params["mag_delay"] or 0.0) / Ts],
-                           hard_iron.coefficients(params, Ts)])
+                            math.nan if params["mag_delay"] is None else params["mag_delay"] / Ts],
+                           hard_iron.coefficients(params, Ts), mag_delay.coefficients(params, Ts)])
 
 
 def initial_state() -> np.ndarray:
@@ -88,7 +94,8 @@ def initial_state() -> np.ndarray:
     began, candidate norm, candidate dip (rad), field samples in the candidate, smallest
     |q·q₀| since the candidate began, q₀ (4, the orientation then), steps since the
     start-up began, the step the candidate began at, steps since the last field sample,
-    the last step's orientation (4; 0: none yet), then blocks.hard_iron's state]."""
+    the last step's orientation (4; 0: none yet), then blocks.hard_iron's and
+    blocks.mag_delay's states]."""
     state = np.zeros(len(STATE_NAMES))
     state[CAND_DOT] = 1.0
     return state
@@ -157,17 +164,21 @@ def _field_sample(state, coef, q, m, horizontal):
 
 
 @kernel(inline=True)
-def turned_back(q, q_prev, steps):
-    """q turned back in the sensor frame by steps (a fraction of) the rotation from q_prev
-    to q: the orientation steps sample times ago at the last step's rate."""
+def step_turn(q_prev, q):
+    """The rotation vector (rad, sensor frame) from q_prev to q."""
     d = quat_multiply((q_prev[0], -q_prev[1], -q_prev[2], -q_prev[3]), q)
     if d[0] < 0.0:
         d = (-d[0], -d[1], -d[2], -d[3])
     s = math.sqrt(d[1] * d[1] + d[2] * d[2] + d[3] * d[3])
-    if s == 0.0:
-        return q
-    k = -2.0 * math.atan2(s, d[0]) * steps / s  # rotation vector back over steps: k·(d_x, d_y, d_z)
-    return quat_multiply(q, rotvec_quat(k * d[1], k * d[2], k * d[3]))
+    k = 2.0 * math.atan2(s, d[0]) / s if s > 0.0 else 2.0
+    return (k * d[1], k * d[2], k * d[3])
+
+
+@kernel(inline=True)
+def turned_back(q, turn, steps):
+    """q turned back in the sensor frame by steps times the last step's rotation turn
+    (rad): the orientation steps sample times ago at the last step's rate."""
+    return quat_multiply(q, rotvec_quat(-steps * turn[0], -steps * turn[1], -steps * turn[2]))
 
 
 @kernel(inline=True)
@@ -176,25 +187,36 @@ def heading_step(state, coef, q, m_sensor):
     attitude filter's orientation (4-tuple), m_sensor the field (3-tuple; a NaN: no field
     sample this step, a slower magnetometer); state in place. Times count steps, so a
     slower magnetometer keeps the time constants in seconds. The field is read against q
-    turned back by mag_delay (coef[9], in steps)."""
+    turned back by mag_delay (coef[9], in steps; NaN: blocks.mag_delay's online estimate)."""
     state[GAP] += 1.0
     if state[SEEN] > 0.0:
         state[STEPS] += 1.0
     ok = False
+    q_prev = (state[Q_PREV], state[Q_PREV + 1], state[Q_PREV + 2], state[Q_PREV + 3])
+    turn = (0.0, 0.0, 0.0)
+    if abs(q_prev[0]) + abs(q_prev[1]) + abs(q_prev[2]) + abs(q_prev[3]) > 0.0:
+        turn = step_turn(q_prev, q)
+    online = math.isnan(coef[9])
+    delay_coef = coef[MAG_DELAY_COEF]
+    rate = (turn[0] / delay_coef[0], turn[1] / delay_coef[0], turn[2] / delay_coef[0])
+    if online:
+        mag_delay.turn(state[MAG_DELAY], delay_coef, rate)
     n2 = m_sensor[0] * m_sensor[0] + m_sensor[1] * m_sensor[1] + m_sensor[2] * m_sensor[2]
     if math.isfinite(n2) and n2 > 0.0:  # a field sample (not NaN: missing, not all 0: none)
-        m_sensor, proven = hard_iron_step(state[HARD_IRON], coef[10:], m_sensor, state[GAP], coef[2], coef[5])
+        m_sensor, proven = hard_iron_step(state[HARD_IRON], coef[HARD_IRON_COEF], m_sensor, state[GAP], coef[2],
+                                          coef[5])
         if proven:  # a field freed of (or back without) an offset: start afresh from it
             state[SEEN] = 0.0
-        q_field = q
-        q_prev = (state[Q_PREV], state[Q_PREV + 1], state[Q_PREV + 2], state[Q_PREV + 3])
-        if coef[9] != 0.0 and abs(q_prev[0]) + abs(q_prev[1]) + abs(q_prev[2]) + abs(q_prev[3]) > 0.0:
-            q_field = turned_back(q, q_prev, coef[9])
+            mag_delay.restart(state[MAG_DELAY])
+        steps = state[MAG_DELAY_IN_USE] / delay_coef[0] if online else coef[9]
+        q_field = turned_back(q, turn, steps) if steps != 0.0 else q
         half = 0.5 * state[0]
         m = quat_rotate(quat_multiply((math.cos(half), 0.0, 0.0, math.sin(half)), q_field), m_sensor)
         horizontal = math.sqrt(m[0] * m[0] + m[1] * m[1])
         if horizontal > 0.0:  # a field with a heading
             ok = _field_sample(state, coef, q, m, horizontal)
+        if online:
+            mag_delay.field_sample(state[MAG_DELAY], delay_coef, m_sensor, rate, ok)
     for i in range(4):
         state[Q_PREV + i] = q[i]
     if abs(state[0]) > math.pi:
@@ -203,10 +225,17 @@ def heading_step(state, coef, q, m_sensor):
     return quat_multiply((math.cos(half), 0.0, 0.0, math.sin(half)), q), ok
 
 
+@kernel(inline=True)
+def delay_in_use(state, coef):
+    """The magnetometer's delay the heading allows for (s): given, or the online estimate."""
+    return state[MAG_DELAY_IN_USE] if math.isnan(coef[9]) else coef[9] * coef[MAG_DELAY_COEF][0]
+
+
 @kernel()
-def run(state, coef, quat, mag, out, accepted, offset):
+def run(state, coef, quat, mag, out, accepted, offset, delay):
     """Per sample: out (N×4) the orientation with magnetometer heading, accepted (N) whether
-    the field passed the guard, offset (N×3) the hard-iron estimate. quat N×4 (sensor →
+    the field passed the guard, offset (N×3) the hard-iron estimate, delay (N) the
+    magnetometer's delay allowed for (s, see delay_in_use). quat N×4 (sensor →
     earth), mag N×3 (any unit, the offset in the same; a row with a NaN is a missing
     sample, a magnetometer slower than the IMU); state (see initial_state) is carried over
     from call to call."""
@@ -217,6 +246,7 @@ def run(state, coef, quat, mag, out, accepted, offset):
         accepted[k] = ok
         for i in range(3):
             offset[k, i] = state[HARD_IRON_OFFSET + i]
+        delay[k] = delay_in_use(state, coef)
 
 
 def heading_system(dt: float, params=None, name: str = "heading"):
@@ -227,7 +257,7 @@ def heading_system(dt: float, params=None, name: str = "heading"):
 
     def advance(state, u):
         out, accepted, offset = np.empty((1, 4)), np.empty(1, dtype=np.bool_), np.empty((1, 3))
-        run(state, coef, u[0:4].reshape(1, 4).copy(), u[4:7].reshape(1, 3).copy(), out, accepted, offset)
+        run(state, coef, u[0:4].reshape(1, 4).copy(), u[4:7].reshape(1, 3).copy(), out, accepted, offset, np.empty(1))
         return state, np.concatenate([out[0], offset[0]])
 
     return sample_system(advance, [f"q_{c}" for c in "wxyz"] + [f"mag_{c}" for c in "xyz"],
@@ -237,10 +267,11 @@ def heading_system(dt: float, params=None, name: str = "heading"):
 
 def with_magnetometer(quat, mag, fs: float, params=None):
     """(orientation with magnetometer heading N×4, accepted N, hard-iron offset N×3 in the
-    field's unit) for a whole recording."""
+    field's unit, the magnetometer's delay allowed for N in s) for a whole recording."""
     out = np.empty_like(quat)
     accepted = np.empty(len(quat), dtype=np.bool_)
     offset = np.empty((len(quat), 3))
+    delay = np.empty(len(quat))
     run(initial_state(), coefficients(resolve(params), 1.0 / fs), np.ascontiguousarray(quat),
-        np.ascontiguousarray(mag, dtype=float), out, accepted, offset)
-    return out, accepted, offset
+        np.ascontiguousarray(mag, dtype=float), out, accepted, offset, delay)
+    return out, accepted, offset, delay

@@ -33,8 +33,8 @@ class AttitudeEstimate:
     offset: np.ndarray | None = None  # N×3 gyro-offset estimate, rad/s, when one was made
     mag_accepted: np.ndarray | None = None  # N, magnetometer samples the heading used
     mag_offset: np.ndarray | None = None  # N×3, µT, hard-iron offset estimate (blocks.hard_iron)
-    mag_delay: float | None = None  # s, the magnetometer's delay behind the gyro the heading allowed for
-    mag_delay_measured: bool = False  # whether mag_delay was measured from the recording (not given)
+    mag_delay: np.ndarray | None = None  # N, s, the magnetometer's delay behind the gyro the heading allowed for
+    mag_delay_source: str | None = None  # "given", "online" (blocks.mag_delay) or "measured" (whole recording)
 
     @property
     def up(self) -> np.ndarray:
@@ -101,8 +101,9 @@ def estimate(
     `offset`). mag (N×3, µT; rows with a NaN are missing samples): heading from the
     magnetometer with a guard against disturbances (blocks.heading); without it the
     heading is the gyro's (6D). The magnetometer's delay behind the gyro, unless given as
-    the parameter mag_delay, is measured from the recording (systems.delays.mag_delay; 0
-    where it cannot be or comes out negative) and returned as `mag_delay`. latency (s):
+    the parameter mag_delay, is estimated online by the heading stage (blocks.mag_delay),
+    or offline measured from the whole recording (systems.delays.mag_delay; 0 where it
+    cannot be or comes out negative); `mag_delay` holds it per sample. latency (s):
     the IMU's delay behind the motion; the estimate is carried forward over it with the
     (offset-free) gyro (blocks.timing).
     gyr_samples: "mean" (the project's convention: sample k is the mean rate over the
@@ -122,7 +123,7 @@ def estimate(
     if not offline:
         forward = _run(step, gyr, acc, initial_gravity)
         forward.offset = offset
-        return _carried_forward(_with_heading(forward, mag, gyr, fs, heading_params), gyr, latency)
+        return _carried_forward(_with_heading(forward, mag, gyr, fs, heading_params, False), gyr, latency)
     gyr_back = time_reversed(gyr)
     if isinstance(step, KernelStepper):
         # wiener's local densities: both passes run at the lower of the break frequencies
@@ -136,7 +137,7 @@ def estimate(
         backward = _run(step, gyr_back, np.ascontiguousarray(forward.gravity[::-1]), forward.gravity[-1]).gravity
     gravity = backward[::-1].copy()
     est = AttitudeEstimate(gravity, level_onto(forward.quat, gravity), offset)
-    return _carried_forward(_with_heading(est, mag, gyr, fs, heading_params), gyr, latency)
+    return _carried_forward(_with_heading(est, mag, gyr, fs, heading_params, True), gyr, latency)
 
 
 def _run_local(step, gyr, acc, initial_gravity, omega=None):
@@ -150,7 +151,7 @@ def _run_local(step, gyr, acc, initial_gravity, omega=None):
     return (gravity, quat), used
 
 
-def _with_heading(est: AttitudeEstimate, mag, gyr, fs: float, params) -> AttitudeEstimate:
+def _with_heading(est: AttitudeEstimate, mag, gyr, fs: float, params, offline: bool) -> AttitudeEstimate:
     if mag is None:
         return est
     mag = np.asarray(mag, dtype=float)
@@ -161,11 +162,10 @@ def _with_heading(est: AttitudeEstimate, mag, gyr, fs: float, params) -> Attitud
         raise ValueError(f"mag has {infinite} infinite values (NaN marks a missing sample)")
     if np.isnan(mag).any(axis=1).all():
         raise ValueError("mag has no sample without NaN: estimate without it (--heading gyro, or mag=None)")
-    est.mag_delay_measured = params.get("mag_delay") is None
-    if est.mag_delay_measured:
+    est.mag_delay_source = "given" if params.get("mag_delay") is not None else "measured" if offline else "online"
+    if est.mag_delay_source == "measured":
         params = {**params, "mag_delay": max(mag_delay(gyr, mag, fs) or 0.0, 0.0)}
-    est.mag_delay = params["mag_delay"]
-    est.quat, est.mag_accepted, est.mag_offset = with_magnetometer(est.quat, mag, fs, params)
+    est.quat, est.mag_accepted, est.mag_offset, est.mag_delay = with_magnetometer(est.quat, mag, fs, params)
     return est
 
 

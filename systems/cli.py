@@ -323,11 +323,14 @@ def _estimate_one(args, path, out, prefix: str) -> None:
 
 
 def _mag_delay_text(result) -> str:
-    if not result.mag_delay_measured:
-        return f"its delay behind the gyro {1e3 * result.mag_delay:.1f} ms (given)"
-    if result.mag_delay == 0.0:
-        return "no delay behind the gyro that the recording shows (--param mag_delay=S sets one)"
-    return f"its delay behind the gyro {1e3 * result.mag_delay:.1f} ms (measured; --param mag_delay=S sets it)"
+    delay, source = 1e3 * result.mag_delay[-1], result.mag_delay_source
+    if source == "given":
+        return f"its delay behind the gyro {delay:.1f} ms (given)"
+    if delay == 0.0:
+        return f"no delay behind the gyro that the recording shows{' so far' if source == 'online' else ''} " \
+               "(--param mag_delay=S sets one)"
+    how = "estimated online, at the end" if source == "online" else "measured from the whole recording"
+    return f"its delay behind the gyro {delay:.1f} ms ({how}; --param mag_delay=S sets it)"
 
 
 def cmd_evaluate(args) -> int:

@@ -8,15 +8,13 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from blocks.jit import kernel
+from blocks.mag_delay import MAG_DELAY_REACH_S, MAG_DELAY_SIGMAS, MAG_SPAN_S
 from blocks.quaternion import integrate_rates, quat_matrix, quat_multiply, rotvec_quat
 
 MAX_GRID = 100  # by default at most this many grid steps either way (steps of a sample or more)
-MAG_DELAY_REACH_S = 0.1  # mag_delay looks this far either way
-MAG_SPAN_S = 0.25  # the field is carried by the gyro over spans of about this long
 MAG_TURN = 0.05  # rad: spans over which the sensor turns less carry no delay
 MAG_MIN_TURNING_S = 5.0  # s of turning spans below which no delay is measured
 MAG_MAX_SPANS = 2_000  # at most this many spans, evenly spread, enter the fit
-MAG_DELAY_SIGMAS = 3.0  # a delay is reported only this many standard errors or more from 0
 MAG_CURVATURE_S = 1e-3  # s: the step over which the fit's curvature in the delay is taken
 MAG_GRID = 10  # grid steps either way (10 ms for MAG_DELAY_REACH_S): the fit's mismatch is smooth in the shift
 MAG_OUTLIER = 5.0  # spans whose residual at no delay exceeds this many times the median are left out

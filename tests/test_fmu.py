@@ -98,18 +98,19 @@ def test_estimator_fmu_equals_the_batch_path(fmu_dir, recording, method, latency
 
 
 def test_estimator_fmu_heading_from_its_magnetometer_inputs_equals_the_batch_path(fmu_dir):
-    """With the magnetometer's delay as a parameter (the batch path measures it when not
-    given; the FMU cannot, so both are told): the FMU is the batch path."""
+    """A magnetometer 20 ms behind the gyro at a third of the rate: the FMU is the batch
+    path, the online estimate of the delay (blocks.mag_delay) included, which takes
+    20.2 ms 5.2 s in."""
     motion = profile("sine_rotation").motion({"inclination_deg": 20.0}).generate(20.0, FS)
     gyr, acc = ImuModel(delta_n=math.radians(0.05), gyr_offset=(0.0, 0.0, 0.01)).apply(motion, seed=3)
     mag = np.vstack([motion.mag[:2], motion.mag[:-2]])  # 20 ms behind the gyro
     mag[1::3] = np.nan  # a magnetometer at a third of the rate: NaN between its samples
-    params = {"mag_delay": 0.02}
-    runner = FmuRunner(fmu_dir / "AttitudeEstimator.fmu", {"gyro_offset": "off", **params},
+    runner = FmuRunner(fmu_dir / "AttitudeEstimator.fmu", {"gyro_offset": "off"},
                        INPUTS + ["mag_x", "mag_y", "mag_z"], OUTPUTS)
     out, _ = runner.run(np.hstack([gyr, acc, mag]), 1 / FS)
     runner.close()
-    ref = estimate(gyr, acc, FS, mag=mag, params=params)
+    ref = estimate(gyr, acc, FS, mag=mag)
+    assert ref.mag_delay_source == "online" and abs(ref.mag_delay[-1] - 0.02) < 1e-3
     assert np.abs(out[:, :4] - ref.quat).max() < 1e-9
     assert np.abs(out[:, :4] - estimate(gyr, acc, FS, mag=mag, params={"mag_delay": 0.0}).quat).max() > 1e-4
     assert not ref.mag_accepted[1::3].any() and ref.mag_accepted[::3].mean() > 0.9
@@ -129,7 +130,7 @@ def test_estimator_fmu_reports_the_hard_iron_estimate_of_the_batch_path(fmu_dir)
                        OUTPUTS + ["mag_offset_x", "mag_offset_y", "mag_offset_z"])
     out, _ = runner.run(np.hstack([gyr, acc, mag]), 1 / FS)
     runner.close()
-    ref = estimate(gyr, acc, FS, mag=mag, params={"mag_delay": 0.0})  # the FMU's default
+    ref = estimate(gyr, acc, FS, mag=mag)
     assert np.abs(out[:, :4] - ref.quat).max() < 1e-9
     assert np.abs(out[:, 7:10] - ref.mag_offset).max() < 1e-9
     assert np.abs(out[-1, 7:10] - [15.0, -5.0, 8.0]).max() < 0.5
@@ -426,9 +427,8 @@ def _batch_pipeline(duration, seed_motion, seed_imu, delta_n, method="wiener", l
     motion = profile("human").motion().generate(duration, FS, seed_motion)
     gyr, acc = ImuModel(delta_n=delta_n, gyr_scale=GYR_SCALE, latency=latency).apply(motion, seed_imu)
     # the sensor passes the field on; the estimator FMU's defaults estimate the gyro offset
-    # and take the magnetometer as on time
-    return motion, estimate(gyr, acc, FS, method, {"mag_delay": 0.0}, mag=motion.mag, gyro_offset=True,
-                            latency=compensated)
+    # and the magnetometer's delay
+    return motion, estimate(gyr, acc, FS, method, mag=motion.mag, gyro_offset=True, latency=compensated)
 
 
 @pytest.mark.parametrize("method", sorted(METHODS))

@@ -121,7 +121,7 @@ def test_closed_loop_diagram_with_offset_and_heading_blocks_equals_the_batch_ker
     est = estimate(gyr - offset, acc, fs, params=noise_density, initial_gravity=[0, 0, motion.g])
     mag = imu.measure_mag(Rotation.from_quat(truth[:, 6:10], scalar_first=True).inv().apply(EARTH_FIELD_UT),
                           noise[:, 12:15], fs)
-    quat, _, mag_offset = with_magnetometer(est.quat, mag, fs, heading_params)
+    quat, _, mag_offset, _ = with_magnetometer(est.quat, mag, fs, heading_params)
     out = dict(zip(resp.output_labels, resp.outputs))
     assert np.abs(np.column_stack([out[f"ghat_{c}"] for c in "xyz"]) - est.gravity).max() <= 1e-12
     assert np.abs(np.column_stack([out[f"qh_{c}"] for c in "wxyz"]) - quat).max() <= 1e-12

@@ -498,7 +498,7 @@ def test_magnetometer_heading_follows_the_field_and_survives_a_disturbance():
     # 100 s of a 30 µT disturbance fixed to the sensor, the hard-iron fit off: rejected, bounded, recovered
     disturbed = mag.copy()
     disturbed[20000:30000] += [30.0, 0.0, 0.0]
-    out, accepted, _ = with_magnetometer(gyro_only.quat, disturbed, FS, {"mag_cal_time": 0.0})
+    out, accepted, _, _ = with_magnetometer(gyro_only.quat, disturbed, FS, {"mag_cal_time": 0.0})
     heading = np.degrees(quaternion_errors(out, motion.quat)[1])
     assert accepted[20000:30000].mean() < 0.2 and accepted[31000:].all()
     assert heading[20000:30000].max() < 30.0  # about the gyro's 0.2 °/s over 100 s, not the field's pull
@@ -540,14 +540,14 @@ def test_a_new_field_needs_the_sensor_to_turn():
     motion, gyr, acc, mag = _turns_with_field()
     mag[20000:] += [30.0, 0.0, 0.0]
     quat = estimate(gyr, acc, FS).quat
-    default, accepted, _ = with_magnetometer(quat, mag, FS, {"mag_cal_time": 0.0})
-    never, _, _ = with_magnetometer(quat, mag, FS, {"mag_new_time": 1e9, "mag_cal_time": 0.0})
+    default, accepted, _, _ = with_magnetometer(quat, mag, FS, {"mag_cal_time": 0.0})
+    never, _, _, _ = with_magnetometer(quat, mag, FS, {"mag_new_time": 1e9, "mag_cal_time": 0.0})
     assert np.array_equal(default, never) and accepted[20000:].mean() < 0.1
     still = np.tile([1.0, 0.0, 0.0, 0.0], (int(200 * FS), 1))
     field = np.tile(EARTH_FIELD_UT, (len(still), 1)).astype(float)
     field[int(30 * FS):] = [0.0, 12.0, -38.0]
     for params, taken in (({}, False), ({"mag_new_angle": 0.0}, True)):
-        _, accepted, _ = with_magnetometer(still, field, FS, params)
+        _, accepted, _, _ = with_magnetometer(still, field, FS, params)
         assert accepted[-int(100 * FS):].all() == taken and not accepted[int(30 * FS):int(49 * FS)].any()
 
 
@@ -560,11 +560,11 @@ def test_a_hard_iron_offset_is_fitted_and_removed(offset, start):
     on the gyro. On the clean field the estimate stays exactly 0."""
     motion, gyr, acc, mag = _turns_with_field()
     quat = estimate(gyr, acc, FS, gyro_offset=True).quat  # 6D
-    _, _, clean_offset = with_magnetometer(quat, mag, FS)
+    _, _, clean_offset, _ = with_magnetometer(quat, mag, FS)
     assert not clean_offset.any()
     mag[int(start * FS):] += offset
     heading_of = lambda out: np.degrees(quaternion_errors(out, motion.quat)[1])
-    out, _, estimate_ = with_magnetometer(quat, mag, FS)
+    out, _, estimate_, _ = with_magnetometer(quat, mag, FS)
     without = heading_of(with_magnetometer(quat, mag, FS, {"mag_cal_time": 0.0})[0])
     taken = int(np.argmax(np.abs(estimate_).sum(axis=1) > 0))
     heading = heading_of(out)
@@ -586,7 +586,7 @@ def test_a_magnet_carried_for_a_while_is_fitted_then_dropped():
     mag[20000:30000] += [30.0, 0.0, 0.0]
     quat = estimate(gyr, acc, FS).quat  # 6D
     rms_heading = lambda out: rms(np.degrees(quaternion_errors(out, motion.quat)[1]))
-    out, _, offset = with_magnetometer(quat, mag, FS)
+    out, _, offset, _ = with_magnetometer(quat, mag, FS)
     used = np.abs(offset).sum(axis=1) > 0
     taken, dropped = int(np.argmax(used)), 30000 + int(np.argmin(used[30000:]))
     without = with_magnetometer(quat, mag, FS, {"mag_cal_time": 0.0})[0]
@@ -602,7 +602,7 @@ def test_a_hard_iron_offset_survives_a_long_rest():
     directions, so it proves neither sphere and the offset taken before stays."""
     motion, _, _, mag = _turns_with_field(rest=(200.0, 500.0), duration=700.0)
     mag += [15.0, -5.0, 8.0]
-    out, _, offset = with_magnetometer(motion.quat, mag, FS)
+    out, _, offset, _ = with_magnetometer(motion.quat, mag, FS)
     taken = int(np.argmax(np.abs(offset).sum(axis=1) > 0))
     heading = np.degrees(quaternion_errors(out, motion.quat)[1])
     assert taken < 20000 and np.abs(offset[taken:] - [15.0, -5.0, 8.0]).max() < 0.5
@@ -622,9 +622,9 @@ def _hard_iron_case():
 def test_heading_compiled_equals_its_plain_python_source():
     code = ("import json; from blocks.heading import with_magnetometer; "
             "from tests.test_real_data import _hard_iron_case;"
-            "out, _, offset = with_magnetometer(*_hard_iron_case(), 100.0);"
+            "out, _, offset, _ = with_magnetometer(*_hard_iron_case(), 100.0);"
             "print(json.dumps([out.tolist(), offset.tolist()]))")
-    out, _, offset = with_magnetometer(*_hard_iron_case(), FS)
+    out, _, offset, _ = with_magnetometer(*_hard_iron_case(), FS)
     assert offset[10000].any() and not offset[-1].any()
     plain_out, plain_offset = (np.array(x) for x in interpreted_json(code))
     assert np.abs(plain_out - out).max() <= 1e-9 and np.abs(plain_offset - offset).max() <= 1e-9
