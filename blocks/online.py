@@ -11,7 +11,7 @@ from .gyro_offset import coefficients as offset_coefficients
 from .gyro_offset import initial_state as offset_initial_state
 from .gyro_offset import resolve as offset_resolve
 from .gyro_offset import run as offset_run
-from .heading import HARD_IRON_OFFSET
+from .heading import HARD_IRON_OFFSET, MAG_DELAY_IN_USE
 from .heading import coefficients as heading_coefficients
 from .heading import heading_step
 from .heading import initial_state as heading_initial_state
@@ -137,6 +137,13 @@ class OnlineEstimator:
     def mag_offset(self) -> np.ndarray:
         """The magnetometer's hard-iron offset estimate (µT, blocks.hard_iron; 0 until one is proven)."""
         return self._heading_state[HARD_IRON_OFFSET:HARD_IRON_OFFSET + 3]
+
+    @property
+    def mag_delay(self) -> float:
+        """The magnetometer's delay behind the gyro the heading allows for (s; the parameter
+        mag_delay, or blocks.mag_delay's online estimate: 0 until one is taken)."""
+        given = self._heading_params["mag_delay"]
+        return float(self._heading_state[MAG_DELAY_IN_USE] if given is None else given)
 
     def step(self, gyr, acc, Ts: float, mag=(0.0, 0.0, 0.0)) -> bool:
         """Take one sample: gyr (rad/s) over the last Ts seconds, acc (m/s²) and mag (µT) now."""

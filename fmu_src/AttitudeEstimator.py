@@ -53,6 +53,8 @@ class AttitudeEstimator(ProjectSlave):
         self.vector("gyr_offset", (0.0, 0.0, 0.0), "rad/s", "estimated gyro offset {c} (gyro_offset on; else 0)", OUT)
         self.vector("mag_offset", (0.0, 0.0, 0.0), "uT", "estimated hard-iron offset {c} of the magnetometer "
                     "(heading mag; 0 until one is proven)", OUT)
+        self.real("mag_delay_used", 0.0, "s", "the magnetometer's delay behind the gyro the heading allows for "
+                  "(the parameter mag_delay, or its online estimate: 0 until one is taken)", OUT)
         self.boolean_output("valid", False, "an estimate is available and the last inputs were finite")
         self.parameter("method", "wiener", f"estimator: {', '.join(METHODS)}")
         self.parameter("heading", "mag", "heading source: mag (magnetometer, hard iron fitted, guarded against disturbances) or gyro")
@@ -110,6 +112,7 @@ class AttitudeEstimator(ProjectSlave):
              self.roll, self.pitch, self.yaw) = io[6:16].tolist()
             self.gyr_offset_x, self.gyr_offset_y, self.gyr_offset_z = self.estimator.offset[0].tolist()
             self.mag_offset_x, self.mag_offset_y, self.mag_offset_z = self.estimator.mag_offset.tolist()
+            self.mag_delay_used = self.estimator.mag_delay
         elif not all(math.isfinite(v) for v in io[0:6].tolist()):
             self.log(f"t={current_time:g}: non-finite input; estimate held", Fmi2Status.warning)
         return True

@@ -139,7 +139,8 @@ def build_parser() -> argparse.ArgumentParser:
     est.add_argument("--offsets", action="store_true",
                      help="add gyr_offset_x,gyr_offset_y,gyr_offset_z (rad/s, the gyro-offset estimate after each "
                           "sample; 0 with --gyro-offset off) and, with magnetometer heading, mag_offset_x,mag_offset_y,"
-                          "mag_offset_z (µT, the hard-iron estimate)")
+                          "mag_offset_z (µT, the hard-iron estimate) and mag_delay (s, the magnetometer's delay "
+                          "behind the gyro allowed for)")
     est.add_argument("--method", default="wiener", choices=sorted(METHODS))
     est.add_argument("--param", type=_param, action="append", default=[], metavar="NAME=VALUE",
                      help="parameter of the method, the gyro-offset or the heading estimator, in the unit listed "
@@ -307,7 +308,7 @@ def _estimate_one(args, path, out, prefix: str) -> None:
     if args.offsets:
         extra["gyr_offset"] = np.zeros_like(rec.gyr) if result.offset is None else result.offset
         if result.mag_offset is not None:
-            extra["mag_offset"] = result.mag_offset
+            extra["mag_offset"], extra["mag_delay"] = result.mag_offset, result.mag_delay
     write_estimate(out, rec.t[rows], result.quat[rows], result.up[rows], euler=args.euler,
                    extra={name: values[rows] for name, values in extra.items()})
     progress(f"wrote {out}")

@@ -546,12 +546,12 @@ def euler_degrees(quat) -> np.ndarray:
 def write_estimate(path, t, quat, up, euler: bool = False, extra=None) -> None:
     """CSV with columns t,q_w,q_x,q_y,q_z,g_x,g_y,g_z (g the unit up-vector, sensor
     coordinates); euler adds roll, pitch and yaw in degrees (EULER_COLUMNS, euler_degrees);
-    extra ({prefix: N×3}) adds prefix_x,prefix_y,prefix_z after them."""
+    extra ({name: N×3 or N}) adds name_x,name_y,name_z, or the column name, after them."""
     columns, table = OUTPUT_COLUMNS, [t, quat, up]
     if euler:
         columns = columns + EULER_COLUMNS
         table.append(euler_degrees(quat))
-    for prefix, values in (extra or {}).items():
-        columns = columns + tuple(f"{prefix}_{a}" for a in "xyz")
+    for name, values in (extra or {}).items():
+        columns = columns + ((name,) if np.ndim(values) == 1 else tuple(f"{name}_{a}" for a in "xyz"))
         table.append(values)
     np.savetxt(path, np.column_stack(table), delimiter=",", header=",".join(columns), comments="", fmt="%.10g")

@@ -80,8 +80,9 @@ def test_euler_adds_the_angles_of_the_fmus_outputs(tmp_path, imu):
 
 
 def test_offsets_add_the_gyro_offset_and_hard_iron_estimates_that_find_the_sensors(tmp_path):
-    """--offsets appends the gyro-offset and hard-iron estimates after each sample, the
-    batch path's (and the FMU's outputs of those names); on 120 s of human motion from a
+    """--offsets appends the gyro-offset and hard-iron estimates and the magnetometer's delay
+    allowed for after each sample, the batch path's (and the FMU's outputs of those names;
+    the delay's is mag_delay_used); on 120 s of human motion from a
     gyro (1, −0.6, 0.4) °/s off and a magnetometer with (15, −10, 5) µT of hard iron they
     end within 0.1 °/s (tracked in motion alone: the motion never rests) and 0.5 µT of the
     truth. With --gyro-offset off the gyro columns are 0; without a magnetometer there are
@@ -97,12 +98,13 @@ def test_offsets_add_the_gyro_offset_and_hard_iron_estimates_that_find_the_senso
     assert main(["estimate", str(tmp_path / "in.csv"), "--out", str(out), "--euler", "--offsets"]) == 0
     header, data = _read_output(out)
     offsets = [f"{s}_offset_{a}" for s in ("gyr", "mag") for a in "xyz"]
-    assert header == [*OUTPUT_COLUMNS, *EULER_COLUMNS, *offsets]
+    assert header == [*OUTPUT_COLUMNS, *EULER_COLUMNS, *offsets, "mag_delay"]
     ref = estimate(gyr, acc, FS, gyro_offset=True, mag=mag)
-    assert np.allclose(data[:, -6:-3], ref.offset, rtol=1e-9, atol=1e-12)
-    assert np.allclose(data[:, -3:], ref.mag_offset, rtol=1e-9, atol=1e-9)
-    assert np.abs(np.degrees(data[-1, -6:-3] - truth_gyr)).max() < 0.1
-    assert np.abs(data[-1, -3:] - truth_mag).max() < 0.5
+    assert np.allclose(data[:, -7:-4], ref.offset, rtol=1e-9, atol=1e-12)
+    assert np.allclose(data[:, -4:-1], ref.mag_offset, rtol=1e-9, atol=1e-9)
+    assert np.allclose(data[:, -1], ref.mag_delay, rtol=1e-9, atol=1e-12)
+    assert np.abs(np.degrees(data[-1, -7:-4] - truth_gyr)).max() < 0.1
+    assert np.abs(data[-1, -4:-1] - truth_mag).max() < 0.5
     assert main(["estimate", str(tmp_path / "in.csv"), "--out", str(out), "--offsets", "--gyro-offset", "off",
                  "--heading", "gyro"]) == 0
     header, data = _read_output(out)

@@ -106,12 +106,13 @@ def test_estimator_fmu_heading_from_its_magnetometer_inputs_equals_the_batch_pat
     mag = np.vstack([motion.mag[:2], motion.mag[:-2]])  # 20 ms behind the gyro
     mag[1::3] = np.nan  # a magnetometer at a third of the rate: NaN between its samples
     runner = FmuRunner(fmu_dir / "AttitudeEstimator.fmu", {"gyro_offset": "off"},
-                       INPUTS + ["mag_x", "mag_y", "mag_z"], OUTPUTS)
+                       INPUTS + ["mag_x", "mag_y", "mag_z"], OUTPUTS + ["mag_delay_used"])
     out, _ = runner.run(np.hstack([gyr, acc, mag]), 1 / FS)
     runner.close()
     ref = estimate(gyr, acc, FS, mag=mag)
     assert ref.mag_delay_source == "online" and abs(ref.mag_delay[-1] - 0.02) < 1e-3
     assert np.abs(out[:, :4] - ref.quat).max() < 1e-9
+    assert np.abs(out[:, 7] - ref.mag_delay).max() < 1e-12
     assert np.abs(out[:, :4] - estimate(gyr, acc, FS, mag=mag, params={"mag_delay": 0.0}).quat).max() > 1e-4
     assert not ref.mag_accepted[1::3].any() and ref.mag_accepted[::3].mean() > 0.9
     # the samples without a field keep the heading correction: the output stays smooth
