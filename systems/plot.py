@@ -99,7 +99,7 @@ def _plot_angles(plt, name, label, t, est, out) -> None:
     axes[1].set_ylabel("°")
     if est.mag_accepted is not None:
         _shade_refused(axes[1], t, est)
-        axes[1].set_title("yaw, from the magnetometer")
+        axes[1].set_title(f"yaw, from the magnetometer ({_delay_text(est)})")
     else:
         axes[1].set_title("yaw, from the gyro (6D)")
     if est.offset is not None:
@@ -114,6 +114,11 @@ def _plot_angles(plt, name, label, t, est, out) -> None:
     fig.tight_layout()
     fig.savefig(out, dpi=110)
     plt.close(fig)
+
+
+def _delay_text(est) -> str:
+    """The magnetometer's delay the heading allowed for at the end, and where it came from."""
+    return f"its delay {1e3 * est.mag_delay[-1]:.1f} ms at the end, {est.mag_delay_source}"
 
 
 def _shade_refused(ax, t, est) -> None:
@@ -133,5 +138,5 @@ def _heading_panel(ax, t, heading_error, est, rmse) -> None:
         ax.axvline(t[k + 1], color="C3", lw=1.0, label=None if i else "hard-iron offset taken or dropped")
     ax.set_xlabel("time, s")
     ax.set_ylabel("heading error, °")
-    ax.set_title(f"heading from the magnetometer, RMSE {rmse:.2f}°")
+    ax.set_title(f"heading from the magnetometer ({_delay_text(est)}), RMSE {rmse:.2f}°")
     ax.legend(loc="upper right")
