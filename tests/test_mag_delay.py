@@ -18,22 +18,29 @@ DELAY_STEPS = 6  # 30 ms at FS
 HARD_IRON_UT = (12.0, -4.0, 7.0)
 
 
+def _field(mag, delay_steps=0, every=3, hard_iron=HARD_IRON_UT, noise=0.5):
+    """The field mag (N×3, µT) as a magnetometer delay_steps behind the gyro (negative:
+    ahead of it) sees it, with white noise (µT) and the hard-iron offset (µT), sampled
+    every `every` steps: NaN between its samples."""
+    n, d = len(mag), abs(delay_steps)
+    ideal = (np.vstack([np.repeat(mag[:1], d, axis=0), mag[:n - d]]) if delay_steps >= 0
+             else np.vstack([mag[d:], np.repeat(mag[-1:], d, axis=0)]))
+    field = ideal + hard_iron + np.random.default_rng(2).normal(0.0, noise, ideal.shape)
+    field[np.arange(n) % every != 0] = np.nan
+    return field
+
+
 def _fast_turns(duration=120.0, hard_iron=HARD_IRON_UT):
     """Turning at up to 3 rad/s about each axis (heading ±86°, tilt ±34° and ±29°):
     (motion, gyr, acc, the field as a magnetometer on time and one DELAY_STEPS behind the
-    gyro see it, each with 0.5 µT noise and the hard-iron offset (µT), sampled at a third
-    of FS: NaN between its samples)."""
+    gyro see it, at a third of FS; see _field)."""
     def angles(t):
         return np.column_stack([1.5 * np.sin(2.0 * t), 0.6 * np.sin(5.0 * t), 0.5 * np.sin(6.0 * t)])
     turns = ClosedFormMotion("turns", lambda t: Rotation.from_euler("ZYX", angles(t)), lambda t: np.zeros((len(t), 3)))
     motion = turns.generate(duration, FS)
     gyr, acc = ImuModel(delta_n=math.radians(0.05)).apply(motion, seed=1)
-    fields = []
-    for ideal in (motion.mag, np.vstack([np.repeat(motion.mag[:1], DELAY_STEPS, axis=0), motion.mag[:-DELAY_STEPS]])):
-        field = ideal + hard_iron + np.random.default_rng(2).normal(0.0, 0.5, ideal.shape)
-        field[np.arange(len(field)) % 3 != 0] = np.nan
-        fields.append(field)
-    return motion, gyr, acc, *fields
+    return (motion, gyr, acc, _field(motion.mag, 0, hard_iron=hard_iron),
+            _field(motion.mag, DELAY_STEPS, hard_iron=hard_iron))
 
 
 def _heading_rmse(quat, motion, skip_s=20.0):
@@ -92,3 +99,21 @@ def test_the_online_estimate_starts_afresh_once_a_hard_iron_offset_is_taken():
     assert abs(est.mag_delay[-1] - DELAY_STEPS / FS) < 1e-3
     assert np.abs(est.mag_offset[-1] - HARD_IRON_UT).max() < 0.5
     assert _heading_rmse(est.quat, motion, skip_s=taken / FS + 20.0) < 0.1
+
+
+def test_the_online_estimate_holds_for_a_slow_magnetometer_a_long_delay_and_one_ahead():
+    """The same turns: a 10 Hz magnetometer 30 ms late, one at a third of the rate 80 ms
+    late (the first-order expansion in d still holds at 3 rad/s), one with 2 µT of noise,
+    and one 20 ms ahead of the gyro, which the estimate clips to 0 (a field read early is
+    not allowed for)."""
+    motion, gyr, acc, _, _ = _fast_turns(hard_iron=(0.0, 0.0, 0.0))
+    cases = {"10 Hz, 30 ms": (DELAY_STEPS, 20, 0.5), "80 ms": (16, 3, 0.5), "2 µT, 30 ms": (DELAY_STEPS, 3, 2.0),
+             "20 ms ahead": (-4, 3, 0.5)}
+    for name, (steps, every, noise) in cases.items():
+        mag = _field(motion.mag, steps, every, (0.0, 0.0, 0.0), noise)
+        online = estimate(gyr, acc, FS, mag=mag)
+        given = estimate(gyr, acc, FS, mag=mag, params={"mag_delay": max(steps, 0) / FS})
+        errors = _heading_rmse(online.quat, motion), _heading_rmse(given.quat, motion)
+        print(f"{name}: {1e3 * online.mag_delay[-1]:.2f} ms, heading {errors[0]:.3f}° (told: {errors[1]:.3f}°)")
+        assert abs(online.mag_delay[-1] - max(steps, 0) / FS) < 1e-3, name
+        assert errors[0] < errors[1] + 0.1, name  # within 0.1° of the heading told the true delay
