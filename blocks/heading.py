@@ -67,7 +67,7 @@ STEPS, CAND_START, GAP, Q_PREV = 12, 13, 14, 15  # the last step's orientation i
 HARD_IRON = slice(19, 19 + hard_iron.STATE_SIZE)  # blocks.hard_iron's state
 HARD_IRON_OFFSET = HARD_IRON.start + hard_iron.OFFSET.start  # its offset estimate in 3 entries from here
 MAG_DELAY = slice(HARD_IRON.stop, HARD_IRON.stop + mag_delay.STATE_SIZE)  # blocks.mag_delay's state
-MAG_DELAY_IN_USE = MAG_DELAY.start + mag_delay.DELAY  # the online estimate in use (s)
+MAG_DELAY_IN_USE = MAG_DELAY.start + mag_delay.DELAY  # the delay allowed for (s): given, or the online estimate
 HARD_IRON_COEF = slice(10, 10 + hard_iron.COEF_SIZE)  # blocks.hard_iron's coefficients
 MAG_DELAY_COEF = slice(HARD_IRON_COEF.stop, HARD_IRON_COEF.stop + mag_delay.COEF_SIZE)
 
@@ -79,13 +79,13 @@ def resolve(overrides=None) -> dict:
 def coefficients(params, Ts: float) -> np.ndarray:
     """[Ts/tau_heading, Ts/tau_reference, mag_norm_tol, mag_dip_tol, heading_clip, steps a
     new field must stay steady, cos(mag_new_angle/2), 1 − exp(−Ts/tau_heading),
-    1 − exp(−Ts/tau_reference), mag_delay/Ts (mag_delay unset: NaN, estimated online), then
+    1 − exp(−Ts/tau_reference), mag_delay (s; unset: NaN, estimated online), then
     blocks.hard_iron's and blocks.mag_delay's coefficients]. Ts is the step (IMU sample) time."""
     return np.concatenate([[Ts / params["tau_heading"], Ts / params["tau_reference"],
                             params["mag_norm_tol"], params["mag_dip_tol"], params["heading_clip"],
                             params["mag_new_time"] / Ts, math.cos(0.5 * params["mag_new_angle"]),
                             1.0 - math.exp(-Ts / params["tau_heading"]), 1.0 - math.exp(-Ts / params["tau_reference"]),
-                            math.nan if params["mag_delay"] is None else params["mag_delay"] / Ts],
+                            math.nan if params["mag_delay"] is None else params["mag_delay"]],
                            hard_iron.coefficients(params, Ts), mag_delay.coefficients(params, Ts)])
 
 
@@ -187,20 +187,22 @@ def heading_step(state, coef, q, m_sensor):
     attitude filter's orientation (4-tuple), m_sensor the field (3-tuple; a NaN: no field
     sample this step, a slower magnetometer); state in place. Times count steps, so a
     slower magnetometer keeps the time constants in seconds. The field is read against q
-    turned back by mag_delay (coef[9], in steps; NaN: blocks.mag_delay's online estimate)."""
+    turned back by the delay in MAG_DELAY_IN_USE: coef[9] (s), or where that is NaN
+    blocks.mag_delay's online estimate."""
     state[GAP] += 1.0
     if state[SEEN] > 0.0:
         state[STEPS] += 1.0
     ok = False
-    q_prev = (state[Q_PREV], state[Q_PREV + 1], state[Q_PREV + 2], state[Q_PREV + 3])
-    turn = (0.0, 0.0, 0.0)
-    if abs(q_prev[0]) + abs(q_prev[1]) + abs(q_prev[2]) + abs(q_prev[3]) > 0.0:
-        turn = step_turn(q_prev, q)
     online = math.isnan(coef[9])
+    if not online:
+        state[MAG_DELAY_IN_USE] = coef[9]
     delay_coef = coef[MAG_DELAY_COEF]
-    rate = (turn[0] / delay_coef[0], turn[1] / delay_coef[0], turn[2] / delay_coef[0])
+    q_prev = (state[Q_PREV], state[Q_PREV + 1], state[Q_PREV + 2], state[Q_PREV + 3])
+    turn = (0.0, 0.0, 0.0)  # the last step's rotation (rad), wanted online or for a given delay
+    if (online or coef[9] != 0.0) and abs(q_prev[0]) + abs(q_prev[1]) + abs(q_prev[2]) + abs(q_prev[3]) > 0.0:
+        turn = step_turn(q_prev, q)
     if online:
-        mag_delay.turn(state[MAG_DELAY], delay_coef, rate)
+        mag_delay.turn(state[MAG_DELAY], delay_coef, turn)
     n2 = m_sensor[0] * m_sensor[0] + m_sensor[1] * m_sensor[1] + m_sensor[2] * m_sensor[2]
     if math.isfinite(n2) and n2 > 0.0:  # a field sample (not NaN: missing, not all 0: none)
         m_sensor, proven = hard_iron_step(state[HARD_IRON], coef[HARD_IRON_COEF], m_sensor, state[GAP], coef[2],
@@ -208,7 +210,7 @@ def heading_step(state, coef, q, m_sensor):
         if proven:  # a field freed of (or back without) an offset: start afresh from it
             state[SEEN] = 0.0
             mag_delay.restart(state[MAG_DELAY])
-        steps = state[MAG_DELAY_IN_USE] / delay_coef[0] if online else coef[9]
+        steps = state[MAG_DELAY_IN_USE] / delay_coef[0]
         q_field = turned_back(q, turn, steps) if steps != 0.0 else q
         half = 0.5 * state[0]
         m = quat_rotate(quat_multiply((math.cos(half), 0.0, 0.0, math.sin(half)), q_field), m_sensor)
@@ -216,6 +218,7 @@ def heading_step(state, coef, q, m_sensor):
         if horizontal > 0.0:  # a field with a heading
             ok = _field_sample(state, coef, q, m, horizontal)
         if online:
+            rate = (turn[0] / delay_coef[0], turn[1] / delay_coef[0], turn[2] / delay_coef[0])
             mag_delay.field_sample(state[MAG_DELAY], delay_coef, m_sensor, rate, ok)
     for i in range(4):
         state[Q_PREV + i] = q[i]
@@ -225,17 +228,11 @@ def heading_step(state, coef, q, m_sensor):
     return quat_multiply((math.cos(half), 0.0, 0.0, math.sin(half)), q), ok
 
 
-@kernel(inline=True)
-def delay_in_use(state, coef):
-    """The magnetometer's delay the heading allows for (s): given, or the online estimate."""
-    return state[MAG_DELAY_IN_USE] if math.isnan(coef[9]) else coef[9] * coef[MAG_DELAY_COEF][0]
-
-
 @kernel()
 def run(state, coef, quat, mag, out, accepted, offset, delay):
     """Per sample: out (N×4) the orientation with magnetometer heading, accepted (N) whether
     the field passed the guard, offset (N×3) the hard-iron estimate, delay (N) the
-    magnetometer's delay allowed for (s, see delay_in_use). quat N×4 (sensor →
+    magnetometer's delay allowed for (s, given or estimated online). quat N×4 (sensor →
     earth), mag N×3 (any unit, the offset in the same; a row with a NaN is a missing
     sample, a magnetometer slower than the IMU); state (see initial_state) is carried over
     from call to call."""
@@ -246,7 +243,7 @@ def run(state, coef, quat, mag, out, accepted, offset, delay):
         accepted[k] = ok
         for i in range(3):
             offset[k, i] = state[HARD_IRON_OFFSET + i]
-        delay[k] = delay_in_use(state, coef)
+        delay[k] = state[MAG_DELAY_IN_USE]
 
 
 def heading_system(dt: float, params=None, name: str = "heading"):

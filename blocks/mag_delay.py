@@ -58,10 +58,10 @@ def coefficients(params, Ts: float) -> np.ndarray:
 
 
 @kernel(inline=True)
-def turn(state, coef, w):
-    """Every step: add the step's rate w (rad/s, 3-tuple) to ∫ω dt."""
+def turn(state, coef, rotation):
+    """Every step: add the step's rotation (rad, 3-tuple) to ∫ω dt."""
     for i in range(3):
-        state[TURN.start + i] += w[i] * coef[0]
+        state[TURN.start + i] += rotation[i]
     state[SINCE] += coef[0]
 
 

@@ -141,9 +141,9 @@ class OnlineEstimator:
     @property
     def mag_delay(self) -> float:
         """The magnetometer's delay behind the gyro the heading allows for (s; the parameter
-        mag_delay, or blocks.mag_delay's online estimate: 0 until one is taken)."""
-        given = self._heading_params["mag_delay"]
-        return float(self._heading_state[MAG_DELAY_IN_USE] if given is None else given)
+        mag_delay from the first step on, or blocks.mag_delay's online estimate: 0 until one
+        is taken)."""
+        return float(self._heading_state[MAG_DELAY_IN_USE])
 
     def step(self, gyr, acc, Ts: float, mag=(0.0, 0.0, 0.0)) -> bool:
         """Take one sample: gyr (rad/s) over the last Ts seconds, acc (m/s²) and mag (µT) now."""
