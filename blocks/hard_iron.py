@@ -22,13 +22,19 @@ otherwise (a disturbance passing by, or a long rest, does not undo a calibration
 b is taken or dropped, the field it leaves is proven homogeneous, and the heading stage
 starts afresh from it.
 
-The field can change for good within the window (a magnet put on or taken off): once
-the window, at least mag_new_time old and covering every direction, fits a sphere (about
-b or about 0) but the latest samples (mean square distance low-passed over
-mag_cal_recent) lie more than mag_cal_tol off it, the sums start afresh from the latest
-sample, so that the fit proves the new field within about a minute instead of mixing it
-with the old one for several. (A younger window's fit is not yet sure enough to be left:
-its error where the sensor turns next alone exceeds the tolerance.)
+The field can change for good within the window (a magnet put on or taken off). The sums
+start afresh from the latest sample, so that the fit proves the new field within about a
+minute instead of mixing it with the old one for several, once the window is at least
+mag_new_time old and
+- the latest samples (mean square distance low-passed over mag_cal_recent) lie more than
+  mag_cal_tol off a sphere the window fits: the one about b, where it covers every
+  direction, or the one about 0 unless b explains the field better (half the distance,
+  as above). The sphere about 0 needs no directions: a field that leaves the norm it
+  held has changed, at rest too (a magnet put on a resting sensor); or
+- the window covers every direction and fits neither sphere: it holds a change (a magnet
+  brought up passes through stronger fields on its way) or a field that varies.
+(A younger window's fit is not yet sure enough to be left: its error where the sensor
+turns next alone exceeds the tolerance.)
 Soft iron (a scaled, skewed sphere) is not modelled. mag_cal_time = 0 switches the
 estimate off.
 """
@@ -179,15 +185,20 @@ def hard_iron_step(state, coef, m, gap, norm_tol, steady_steps):
     recent_raw = _recent(state, RECENT_RAW, m, (0.0, 0.0, 0.0), raw_radius, a)
     fits = radius > 0.0 and distance < tol * radius
     raw_fits = raw_distance < tol * raw_radius
-    left = state[AGE] >= steady_steps and ((fits and recent_fit > tol * tol) or (raw_fits and recent_raw > tol * tol))
     offset = math.sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2])
-    explained = fits and distance < EXPLAINED * raw_distance and offset > norm_tol * radius
+    better = fits and distance < EXPLAINED * raw_distance  # the sphere about b, not about 0, is the window's
+    explained = better and offset > norm_tol * radius
+    left_fit = fits and recent_fit > tol * tol
+    # the sphere about 0 needs no spread: samples off the field's own norm, even at rest, show it has changed
+    left_raw = raw_fits and not better and recent_raw > tol * tol
     was_used = state[OFFSET.start] != 0.0 or state[OFFSET.start + 1] != 0.0 or state[OFFSET.start + 2] != 0.0
-    raw_fits = raw_fits and was_used  # only an offset in use can be dropped
-    if (left or explained or raw_fits) and _spread(state[SUMS]) < spread_min * (radius if fits else raw_radius):
-        left = explained = raw_fits = False  # too few directions to tell a sphere
-    if left:
-        # the latest samples have left the sphere the window fits: the field has changed, the fit starts afresh
+    drop = raw_fits and was_used  # only an offset in use can be dropped
+    unfit = not (fits or raw_fits)  # the window fits neither sphere: it holds a change, or a field that varies
+    if (left_fit or explained or drop or unfit) and _spread(state[SUMS]) < spread_min * (radius if fits else raw_radius):
+        left_fit = explained = drop = unfit = False  # too few directions to tell a sphere
+    if state[AGE] >= steady_steps and (left_fit or left_raw or unfit):
+        # the field has changed (the latest samples have left the window's sphere, or a window covering every
+        # direction fits none): the fit starts afresh
         _accumulate(state[SUMS], m, 0.0)
         state[FIT_STEPS] = state[RAW_STEPS] = state[RECENT_FIT] = state[RECENT_RAW] = state[AGE] = 0.0
         return _less_offset(m, state), False
@@ -199,7 +210,7 @@ def hard_iron_step(state, coef, m, gap, norm_tol, steady_steps):
             for i in range(3):
                 state[OFFSET.start + i] = b[i]
             changed = not was_used
-    elif raw_fits:
+    elif drop:
         state[RAW_STEPS] += gap
         state[FIT_STEPS] = 0.0
         if state[RAW_STEPS] >= steady_steps:
