@@ -33,7 +33,7 @@ MAG_UNITS = {"uT": 1.0, "nT": 1e-3, "G": 100.0, "mG": 0.1}  # to µT
 T_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}  # to s
 RATE_RANGE_HZ = (1.0, 1e5)  # sample rates an IMU recording can have; outside, the time unit is wrong
 EARTH_FIELD_RANGE_UT = (20.0, 70.0)  # the geomagnetic field's norm anywhere on earth, about 22–67 µT
-MAX_GYRO_RAD_S = 40.0  # beyond the ±2000 °/s range of MEMS gyros: such values are not rad/s
+MAX_GYRO_RAD_S = math.radians(4000.0)  # beyond the widest range of MEMS gyros (±4000 °/s): such values are not rad/s
 MAX_GAP_S = 1.0  # longest run of missing samples filled in by default (s)
 UNIT_TOLERANCE = 0.1  # largest departure of a reference quaternion's norm from 1 (rounded columns pass)
 SATURATION_S = 0.02  # s: a run this long at exactly a column's largest magnitude is the sensor's range
@@ -103,7 +103,7 @@ def read_recording(path, fs: float | None = None, gyr_unit: str = "rad/s", acc_u
                    acc_axes: str | None = None, mag_axes: str | None = None) -> Recording:
     """Read a CSV (header t,gyr_x..z,acc_x..z[,mag_x..z][,ref_q_w..z][,movement]; t may be
     replaced by fs) or a BROAD .mat, in the units given (GYR_UNITS, ACC_UNITS, MAG_UNITS,
-    T_UNITS), into rad/s, m/s², µT and s. columns ({our name: the CSV's}) reads a header
+    T_UNITS), into rad/s, m/s², µT and s (values no IMU gives: _check_values). columns ({our name: the CSV's}) reads a header
     with other names (a logger's export) without editing the file. gyr_axes, acc_axes,
     mag_axes: signed axis maps into the output's frame (systems.axes.parse_axes); an
     accelerometer or magnetometer that does not turn as the gyro says is noted
@@ -448,10 +448,9 @@ def _check_rate(name, fs: float) -> None:
                              f"are the time stamps in seconds? If not, pass --t-unit ({', '.join(T_UNITS)})")
 
 
-def _unit_hint(flag: str, units: dict, given: str, value: float, plausible) -> str:
-    """The unit of `units` that would make value (read in `given`) plausible, as a hint."""
-    fits = [u for u, factor in units.items() if u != given and plausible(value / units[given] * factor)]
-    return f"; looks like {fits[0]}: pass {flag} {fits[0]}" if fits else ""
+def _other_unit(units: dict, given: str, value: float, plausible) -> str | None:
+    """The unit of `units` that would make value (read in `given`) plausible, if any."""
+    return next((u for u, factor in units.items() if u != given and plausible(value / units[given] * factor)), None)
 
 
 def _check_shapes(rec: Recording) -> None:
@@ -518,16 +517,24 @@ def _saturation_notes(rec: Recording) -> list[str]:
 
 
 def _check_values(rec: Recording, gyr_unit: str, acc_unit: str) -> None:
+    """The gyro's peak and the accelerometer's median norm against what IMUs give: values
+    that another unit would make plausible are a unit mistake, refused with the flag that
+    fixes it; values no unit explains (a sensor shaken far harder than a person moves) are
+    noted, and read as they are."""
     peak = float(np.max(np.abs(rec.gyr)))
-    if peak > MAX_GYRO_RAD_S:
-        hint = _unit_hint("--gyr-unit", GYR_UNITS, gyr_unit, peak, lambda p: p <= MAX_GYRO_RAD_S)
-        raise RecordingError(f"{rec.name}: gyro reaches {peak:.1f} rad/s read as {gyr_unit}, beyond any MEMS gyro{hint}")
     norm = float(np.median(np.linalg.norm(rec.acc, axis=1)))
-    plausible = lambda n: 4.0 < n < 20.0  # m/s², gravity and a person's motion
-    if not plausible(norm):
-        hint = _unit_hint("--acc-unit", ACC_UNITS, acc_unit, norm, plausible)
-        raise RecordingError(f"{rec.name}: median accelerometer norm is {norm:.3g} m/s² read as {acc_unit}, "
-                             f"far from gravity{hint}")
+    for flag, units, given, value, plausible, what in (
+        ("--gyr-unit", GYR_UNITS, gyr_unit, peak, lambda p: p <= MAX_GYRO_RAD_S,
+         f"gyro reaches {peak:.1f} rad/s read as {gyr_unit}, beyond any MEMS gyro"),
+        ("--acc-unit", ACC_UNITS, acc_unit, norm, lambda n: 4.0 < n < 20.0,  # m/s², gravity and a person's motion
+         f"median accelerometer norm is {norm:.3g} m/s² read as {acc_unit}, far from gravity"),
+    ):
+        if plausible(value):
+            continue
+        other = _other_unit(units, given, value, plausible)
+        if other is not None:
+            raise RecordingError(f"{rec.name}: {what}; looks like {other}: pass {flag} {other}")
+        rec.notes.append(f"{rec.name}: {what}, and no other unit ({', '.join(units)}) explains it; read as it is")
     if rec.quat_ref is not None:
         norm = np.linalg.norm(rec.quat_ref, axis=1)
         bad = np.isfinite(norm) & (np.abs(norm - 1.0) > UNIT_TOLERANCE)

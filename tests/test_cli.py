@@ -123,6 +123,25 @@ def test_estimate_without_t_column_needs_fs_and_honours_units(tmp_path, imu):
         assert np.abs(_read_output(out)[1][:, 1:5] - ref.quat).max() < 1e-8, gyr_unit
 
 
+def test_values_no_unit_explains_are_noted_and_estimated_as_read(tmp_path, imu, capsys):
+    """A sensor shaken far harder than a person moves (median accelerometer norm 11 g), which
+    no other unit would make plausible, is noted and estimated as the batch path does (a
+    unit mistake is refused: test_bad_input_ends_with_a_message_and_exit_2). A gyro
+    reaching 67 rad/s (3800 °/s) is within the widest MEMS range and read without a note."""
+    gyr, acc = imu
+    for scaled_gyr, scaled_acc, note in (
+        (gyr, acc * 10.0, "note: in: median accelerometer norm is 111 m/s² read as m/s2, far from gravity, and no "
+                          "other unit (m/s2, g, mg) explains it; read as it is"),
+        (gyr * 20.0, acc, None),
+    ):
+        _write_csv(tmp_path / "in.csv", _imu_columns(scaled_gyr, scaled_acc))
+        assert main(["estimate", str(tmp_path / "in.csv"), "--out", str(tmp_path / "out.csv")]) == 0
+        err = capsys.readouterr().err
+        assert (note in err) if note else ("note:" not in err), err
+        expected = estimate(scaled_gyr, scaled_acc, FS, gyro_offset=True).quat
+        assert np.abs(_read_output(tmp_path / "out.csv")[1][:, 1:5] - expected).max() < 1e-8
+
+
 def test_estimate_takes_the_magnetometer_unit_and_notes_a_norm_far_from_the_earths(tmp_path, imu, capsys):
     """--mag-unit G converts to µT: the estimate and the reported hard-iron offset are those
     of the field in µT. Without it the field in G (norm 0.5) is noted as far from the
