@@ -103,7 +103,8 @@ def read_recording(path, fs: float | None = None, gyr_unit: str = "rad/s", acc_u
                    acc_axes: str | None = None, mag_axes: str | None = None) -> Recording:
     """Read a CSV (header t,gyr_x..z,acc_x..z[,mag_x..z][,ref_q_w..z][,movement]; t may be
     replaced by fs) or a BROAD .mat, in the units given (GYR_UNITS, ACC_UNITS, MAG_UNITS,
-    T_UNITS), into rad/s, m/s², µT and s (values no IMU gives: _check_values). columns ({our name: the CSV's}) reads a header
+    T_UNITS), into rad/s, m/s², µT and s (values no IMU gives: _check_values). columns
+    ({our name: the CSV's}) reads a header
     with other names (a logger's export) without editing the file. gyr_axes, acc_axes,
     mag_axes: signed axis maps into the output's frame (systems.axes.parse_axes); an
     accelerometer or magnetometer that does not turn as the gyro says is noted
