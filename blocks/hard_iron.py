@@ -194,7 +194,8 @@ def hard_iron_step(state, coef, m, gap, norm_tol, steady_steps):
     was_used = state[OFFSET.start] != 0.0 or state[OFFSET.start + 1] != 0.0 or state[OFFSET.start + 2] != 0.0
     drop = raw_fits and was_used  # only an offset in use can be dropped
     unfit = not (fits or raw_fits)  # the window fits neither sphere: it holds a change, or a field that varies
-    if (left_fit or explained or drop or unfit) and _spread(state[SUMS]) < spread_min * (radius if fits else raw_radius):
+    covered = spread_min * (radius if fits else raw_radius)  # the least spread that tells a sphere
+    if (left_fit or explained or drop or unfit) and _spread(state[SUMS]) < covered:
         left_fit = explained = drop = unfit = False  # too few directions to tell a sphere
     if state[AGE] >= steady_steps and (left_fit or left_raw or unfit):
         # the field has changed (the latest samples have left the window's sphere, or a window covering every

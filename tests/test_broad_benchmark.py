@@ -132,9 +132,9 @@ def test_the_attached_magnet_scaled_down_is_taken_or_left_to_the_guard(scale):
                                              np.ascontiguousarray(mag))["quat9D"]
     on = slice(int(50 * rec.fs), int(85 * rec.fs))  # the magnet on, the sensor turning
     used = est.mag_offset.any(axis=1)
-    print(f"magnet × {scale:.3f} ({np.linalg.norm(scale * magnet[on], axis=1).mean():.1f} µT): "
-          f"taken at {np.argmax(used) / rec.fs if used.any() else None} s, heading {heading:.2f}°, "
-          f"vqf_9d {errors_on_movement(peer, rec)['heading_rmse_deg']:.2f}°")
+    taken_at = f"taken at {np.argmax(used) / rec.fs:.1f} s" if used.any() else "not taken"
+    print(f"magnet × {scale:.3f} ({np.linalg.norm(scale * magnet[on], axis=1).mean():.1f} µT): {taken_at}, "
+          f"heading {heading:.2f}°, vqf_9d {errors_on_movement(peer, rec)['heading_rmse_deg']:.2f}°")
     if scale >= 0.125:
         taken = used[on]
         assert taken.any()
