@@ -6,15 +6,16 @@ Both sides low-passed to first order at 1/MAG_SPAN_S (the spans of the batch mea
 systems.delays) give y = L[ṁ + ω × m] = d·L[ω̇ × m] = d·J, and d is their least-squares
 ratio Σ y·J / Σ |J|², over the field samples the guard accepted, with a memory of
 tau_mag_delay. Between two field samples (a slower magnetometer) the rate is summed:
-over the interval Δ, ṁ·Δ = m₁ − m₀, ∫ω × m ≈ (∫ω)×(m₀ + m₁)/2 and ∫ω̇ × m ≈ (ω₁ − ω₀)×(m₀ + m₁)/2,
-with ω the last step's rate.
+over the interval Δ, ṁ·Δ = m₁ − m₀, ∫ω × m ≈ (∫ω)×(m₀ + m₁)/2 and
+∫ω̇ × m ≈ (ω₁ − ω₀)×(m₀ + m₁)/2, with ω the last step's rate.
 
 The residual's standard error takes the low-pass's correlation time 1/a (an upper bound:
 the magnetometer's white noise differentiated is bluer): SE² = (2/a)·⟨|r|²⟩/(3·Σ|J|²·Δ).
 The delay in use changes only when the estimate lies MAG_DELAY_SIGMAS standard errors
-from 0 or more, over MAG_DELAY_MIN_S of samples at least; it is clipped to [0, MAG_DELAY_REACH_S] and otherwise held (0 at the
-start), so a rest, which carries no information, keeps the last value. A hard-iron
-offset taken or dropped (the field changes) starts the estimate afresh.
+from 0 or more, over MAG_DELAY_MIN_S of samples at least; it is clipped to
+[0, MAG_DELAY_REACH_S] and otherwise held (0 at the start), so a rest, which carries no
+information, keeps the last value. A hard-iron offset taken or dropped (the field
+changes) starts the estimate afresh.
 """
 from __future__ import annotations
 

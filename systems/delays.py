@@ -106,6 +106,7 @@ def mag_delay(gyr, mag, fs: float) -> float | None:
         return None
     error = np.sum(residuals(0.0, keep) ** 2, axis=1)
     keep = keep[error <= MAG_OUTLIER * np.median(error)]
+
     def mismatch(shift):
         return float(np.mean(np.sum(residuals(shift, keep) ** 2, axis=1)))
 
