@@ -17,7 +17,7 @@ from .heading import heading_step
 from .heading import initial_state as heading_initial_state
 from .heading import resolve as heading_resolve
 from .jit import kernel
-from .timing import carry_forward, check_gyr_samples, check_latency, interval_mean
+from .timing import carry_forward, check_latency, check_samples, interval_end, interval_mean
 from .methods import method as get_method, stepper
 from .quaternion import quat_euler_zyx
 from .sensor_frame import SensorFrameStepper, sensor_frame_step, start_gravity
@@ -93,13 +93,16 @@ class OnlineEstimator:
     path's gyro_offset argument). latency (s): the outputs are carried forward over the
     IMU's delay (blocks.timing, as the batch path's latency argument); gyr_samples "point":
     each gyro input is the rate at the sample's time, averaged with the last finite one
-    into the mean over the sample time (blocks.timing.interval_means). The filter starts
+    into the mean over the sample time (blocks.timing.interval_means); acc_samples "mean":
+    each accelerometer input is the mean over the sample time, turned into the sensor frame
+    at its end (blocks.timing.interval_end). The filter starts
     at rest on the first accelerometer sample with non-zero norm, as the batch path starts
     on its first sample; until then `ready` is False.
     """
 
     def __init__(self, method: str = "wiener", params: Mapping[str, float] | None = None, heading: bool = False,
-                 gyro_offset: bool = False, latency: float = 0.0, gyr_samples: str = "mean"):
+                 gyro_offset: bool = False, latency: float = 0.0, gyr_samples: str = "mean",
+                 acc_samples: str = "point"):
         params, offset_params, heading_params = split_params(method, params, gyro_offset, heading)
         m = get_method(method)
         m.runs_kernel(m.resolve(params))  # refuse bad parameters now
@@ -109,7 +112,8 @@ class OnlineEstimator:
         self.heading = heading
         self.gyro_offset = gyro_offset
         self.latency = check_latency(latency)
-        self.point_samples = check_gyr_samples(gyr_samples) == "point"
+        gyr_samples, acc_samples = check_samples(gyr_samples, acc_samples)
+        self.point_samples, self.mean_acc = gyr_samples == "point", acc_samples == "mean"
         self.offset = np.zeros((2, 3))  # offset estimate (rad/s) and its variance ((rad/s)²)
         self.io = np.zeros(19)
         self._Ts = None
@@ -172,6 +176,8 @@ class OnlineEstimator:
             if self._last_gyr is not None:
                 self.io[0:3] = interval_mean(self._last_gyr, raw)
             self._last_gyr = raw
+        if self.mean_acc:
+            self.io[3:6] = interval_end(tuple(self.io[0:3]), tuple(self.io[3:6]), Ts)
         starting = self.state is None
         if starting:
             if not (np.isfinite(self.io[IO_INPUTS]).all() and np.any(self.io[3:6])):

@@ -1,4 +1,4 @@
-"""Sample timing: the gyro's sample convention and latency compensation.
+"""Sample timing: the gyro's and the accelerometer's sample conventions and latency compensation.
 
 The project's convention (design NOTES): gyro sample k is the mean rate over the sample
 time before t_k, (t_k−1, t_k], as a closed-form motion's `at` and the FMU's `gyr` input.
@@ -6,6 +6,13 @@ Many sources give the rate at t_k instead (a simulation's ω(t_k), a multibody m
 output, most IMU drivers): `gyr_samples` "point" turns those into interval means by the
 trapezoid, (ω_k−1 + ω_k)/2. Integrated as means, point samples lead the motion by Ts/2
 (on a ±10° pitch at 0.5 Hz sampled at 100 Hz, 0.12° of tilt RMS; tests/test_real_data.py).
+An accelerometer sample is the specific force at t_k (`acc_samples` "point", the
+convention's). One averaged over the sample time as the gyro is (a recording averaged
+down to a lower rate, an IMU whose filters treat both alike: `acc_samples` "mean") sees
+the sensor about Ts/2 earlier; it is turned into the sensor frame at t_k by the second
+half of the step's rotation, exp(−[ω]·Ts/2), the turn carry_forward gives the up-vector.
+Read as point values, such means lag by |ω|·Ts/2 of tilt, which the filter passes
+through its low-pass B.
 
 Latency: an IMU's samples lag the motion (the group delay of its digital filters, a few
 milliseconds), so an estimate made from them shows the orientation of that long ago.
@@ -28,13 +35,15 @@ from .stepper_system import sample_system
 
 MAX_LATENCY_S = 0.5  # the gyro's last rate is no guide to the orientation further ahead
 GYR_SAMPLES = ("mean", "point")  # the gyro's sample convention (module docstring)
+ACC_SAMPLES = ("point", "mean")  # the accelerometer's
 
 
-def check_gyr_samples(value: str) -> str:
-    """value, refused unless one of GYR_SAMPLES."""
-    if value not in GYR_SAMPLES:
-        raise ValueError(f"gyr_samples must be {' or '.join(map(repr, GYR_SAMPLES))}, got {value!r}")
-    return value
+def check_samples(gyr_samples: str, acc_samples: str = "point") -> tuple[str, str]:
+    """(gyr_samples, acc_samples), refused unless in GYR_SAMPLES and ACC_SAMPLES."""
+    for name, value, allowed in (("gyr_samples", gyr_samples, GYR_SAMPLES), ("acc_samples", acc_samples, ACC_SAMPLES)):
+        if value not in allowed:
+            raise ValueError(f"{name} must be {' or '.join(map(repr, allowed))}, got {value!r}")
+    return gyr_samples, acc_samples
 
 
 def interval_mean(before, now):
@@ -76,6 +85,25 @@ def carry_forward_rows(quat, gravity, gyr, latency):
                               (gyr[k, 0], gyr[k, 1], gyr[k, 2]), latency)
         quat[k, 0], quat[k, 1], quat[k, 2], quat[k, 3] = q
         gravity[k, 0], gravity[k, 1], gravity[k, 2] = up
+
+
+@kernel(inline=True)
+def interval_end(gyr, acc, Ts):
+    """acc (3-tuple, m/s²), a mean over the sample time (t_k−1, t_k], in the sensor frame
+    at t_k: turned as carry_forward turns the up-vector over Ts/2 (s) at the step's mean
+    rate gyr (3-tuple, rad/s)."""
+    return carry_forward((1.0, 0.0, 0.0, 0.0), acc, gyr, 0.5 * Ts)[1]
+
+
+@kernel()
+def interval_ends(gyr, acc, Ts):
+    """interval_end on every row: accelerometer means (N×3, m/s²) in the sensor frame at
+    each sample's time, a new array; gyr N×3 (rad/s, the means over the same sample times)."""
+    out = np.empty_like(acc)
+    for k in range(acc.shape[0]):
+        out[k, 0], out[k, 1], out[k, 2] = interval_end((gyr[k, 0], gyr[k, 1], gyr[k, 2]),
+                                                      (acc[k, 0], acc[k, 1], acc[k, 2]), Ts)
+    return out
 
 
 def latency_system(dt: float, latency: float, quat_inputs=("q_w", "q_x", "q_y", "q_z"), name: str = "latency"):

@@ -44,7 +44,8 @@ class AttitudeEstimator(ProjectSlave):
         super().__init__(**kwargs)
         self.vector("gyr", (0.0, 0.0, 0.0), "rad/s", "gyro {c}, mean rate over the step (gyr_samples mean) "
                     "or the rate at its end (point)", IN)
-        self.vector("acc", (0.0, 0.0, 9.81), "m/s2", "specific force {c} at the end of the step", IN)
+        self.vector("acc", (0.0, 0.0, 9.81), "m/s2", "specific force {c} at the end of the step (acc_samples point) "
+                    "or its mean over the step (mean)", IN)
         self.vector("mag", (0.0, 0.0, 0.0), "uT", "magnetic field {c}; all 0: no magnetometer (heading from the gyro); NaN: no sample this step", IN)
         self.vector("q", (1.0, 0.0, 0.0, 0.0), "1", "orientation quaternion {c}, sensor -> earth (ENU)", OUT, "wxyz")
         self.vector("g", (0.0, 0.0, 1.0), "1", "estimated unit up-vector {c}, sensor coordinates", OUT)
@@ -64,6 +65,9 @@ class AttitudeEstimator(ProjectSlave):
         self.parameter("gyr_samples", "mean", "mean: gyr is the mean rate over the step (the FMI convention of "
                        "MotionProfile and ImuSensor); point: the rate at the step's end (most models' outputs), "
                        "averaged with the last one")
+        self.parameter("acc_samples", "point", "point: acc is the specific force at the step's end (the FMI "
+                       "convention of MotionProfile and ImuSensor); mean: its mean over the step (a sensor that "
+                       "averages it as the gyro), turned to the step's end by half the step's rotation")
         self.real("latency", 0.0, "s", "the IMU's delay behind the motion (its filters' group delay, gyr taken as the "
                   "mean rate over the step); q and g are carried forward over it with the gyro", PAR)
         for name, (unit, doc, start) in tuning_parameters().items():
@@ -86,7 +90,7 @@ class AttitudeEstimator(ProjectSlave):
         try:
             self.estimator = OnlineEstimator(self.method, params, heading=self.heading == "mag",
                                              gyro_offset=self.gyro_offset == "on", latency=self.latency,
-                                             gyr_samples=self.gyr_samples)
+                                             gyr_samples=self.gyr_samples, acc_samples=self.acc_samples)
         except ValueError as exc:
             self.fail(f"invalid parameter: {exc}")
 

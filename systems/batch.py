@@ -12,7 +12,7 @@ from scipy.spatial.transform import Rotation
 from blocks import gyro_offset as offset_stage, heading as heading_stage
 from blocks.gyro_offset import correct as correct_gyro
 from blocks.heading import with_magnetometer
-from blocks.timing import carry_forward_rows, check_gyr_samples, check_latency, interval_means
+from blocks.timing import carry_forward_rows, check_latency, check_samples, interval_ends, interval_means
 from blocks.stages import split_params
 from blocks.methods import METHODS, KernelStepper, method as get_method, stepper
 from blocks.sensor_frame import start_gravity, time_reversed
@@ -62,11 +62,12 @@ def check_imu(gyr, acc, fs: float) -> tuple[np.ndarray, np.ndarray]:
 
 
 def check_options(method: str = "wiener", params: Mapping[str, float] | None = None, offline: bool = False,
-                  gyro_offset: bool = False, mag: bool = False, latency: float = 0.0, gyr_samples: str = "mean"):
+                  gyro_offset: bool = False, mag: bool = False, latency: float = 0.0, gyr_samples: str = "mean",
+                  acc_samples: str = "point"):
     """Refuse what estimate() would refuse of its options, before any data is read: an
     unknown method, a parameter no running stage has or a value out of range, --offline
-    with a method that is not an earth-frame filter, a latency or gyr_samples out of
-    range. mag: whether a magnetometer will be given. Returns the parameters split into
+    with a method that is not an earth-frame filter, a latency, gyr_samples or acc_samples
+    out of range. mag: whether a magnetometer will be given. Returns the parameters split into
     the method's, the gyro-offset estimator's and the heading estimator's
     (blocks.stages.split_params) and the latency (s)."""
     m = get_method(method)
@@ -78,14 +79,14 @@ def check_options(method: str = "wiener", params: Mapping[str, float] | None = N
     if offline and not m.is_sensor_frame:
         raise ValueError(f"offline smoothing needs an earth-frame filter method "
                          f"({', '.join(n for n, m in METHODS.items() if m.is_sensor_frame)}), not {method!r}")
-    check_gyr_samples(gyr_samples)
+    check_samples(gyr_samples, acc_samples)
     return split, check_latency(latency)
 
 
 def estimate(
     gyr, acc, fs: float, method: str = "wiener", params: Mapping[str, float] | None = None,
     initial_gravity=None, offline: bool = False, gyro_offset: bool = False, mag=None, latency: float = 0.0,
-    gyr_samples: str = "mean",
+    gyr_samples: str = "mean", acc_samples: str = "point",
 ) -> AttitudeEstimate:
     """Estimate attitude over a recording: gyr N×3 rad/s, acc N×3 m/s², fs in Hz.
 
@@ -108,12 +109,17 @@ def estimate(
     (offset-free) gyro (blocks.timing).
     gyr_samples: "mean" (the project's convention: sample k is the mean rate over the
     sample time before it) or "point" (the rate at t_k, turned into means first).
+    acc_samples: "point" (the convention: the specific force at t_k) or "mean" (over the
+    sample time before it, turned into the sensor frame at t_k first; blocks.timing).
     """
     (params, offset_params, heading_params), latency = check_options(method, params, offline, gyro_offset,
-                                                                     mag is not None, latency, gyr_samples)
+                                                                     mag is not None, latency, gyr_samples,
+                                                                     acc_samples)
     gyr, acc = check_imu(gyr, acc, fs)
     if gyr_samples == "point":
         gyr = interval_means(gyr)
+    if acc_samples == "mean":
+        acc = interval_ends(gyr, acc, 1.0 / fs)
     offset = None
     if gyro_offset:
         gyr, offset = correct_gyro(gyr, acc, fs, offset_params, offline=offline)

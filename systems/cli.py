@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from blocks.timing import GYR_SAMPLES, check_latency
+from blocks.timing import ACC_SAMPLES, GYR_SAMPLES, check_latency
 from blocks.methods import METHODS
 from blocks.methods import method as known_method
 from blocks.stages import ESTIMATORS
@@ -101,6 +101,11 @@ def _add_input_flags(parser) -> None:
                         help="mean: a gyro sample is the mean rate over the sample time before it (default; the "
                              "project's convention); point: the rate at the sample's time (simulations that sample "
                              "ω(t), most IMU drivers), turned into means by the trapezoid")
+    parser.add_argument("--acc-samples", default="point", choices=list(ACC_SAMPLES),
+                        help="point: an accelerometer sample is the specific force at the sample's time (default; "
+                             "the project's convention); mean: its mean over the sample time before it (a "
+                             "recording averaged down to a lower rate, a sensor that averages it as the gyro), "
+                             "turned to the sample's time by half the step's rotation")
     parser.add_argument("--latency", type=float, default=0.0, metavar="S",
                         help="the IMU's delay behind the motion in seconds (its filters' group delay), counted in "
                              "the means the estimator takes (point samples taken S late, with --gyr-samples point): "
@@ -264,7 +269,7 @@ def cmd_estimate(args) -> int:
     from .batch import check_options
 
     check_options(args.method, dict(args.param), args.offline, args.gyro_offset == "on", args.heading == "mag",
-                  args.latency, args.gyr_samples)
+                  args.latency, args.gyr_samples, args.acc_samples)
     outputs = _estimate_outputs(args.input, args.out)
     failed = []
     for number, (path, out) in enumerate(zip(args.input, outputs), 1):
@@ -301,7 +306,7 @@ def _estimate_one(args, path, out, prefix: str) -> None:
     print_notes(rec.notes + ([field_norm_note(rec)] if args.heading == "mag" else []))
     result = estimate(rec.gyr, rec.acc, rec.fs, args.method, dict(args.param), offline=args.offline,
                       gyro_offset=args.gyro_offset == "on", mag=rec.mag if args.heading == "mag" else None,
-                      latency=args.latency, gyr_samples=args.gyr_samples)
+                      latency=args.latency, gyr_samples=args.gyr_samples, acc_samples=args.acc_samples)
     progress(f"estimated with {args.method}{' --offline' if args.offline else ''}")
     rows = slice(None) if rec.filled is None else ~rec.filled  # the input's rows, not those filled in
     extra = {}
@@ -345,7 +350,8 @@ def cmd_evaluate(args) -> int:
                            "install them with: pip install 'attitude-fmu[peers]'") from None
     result = evaluate(args.files, args.method, dict(args.param), args.offline, args.gyro_offset == "on",
                       args.heading == "mag", start_in_movement=args.start_in_movement,
-                      read_options=_read_options(args), latency=args.latency, gyr_samples=args.gyr_samples)
+                      read_options=_read_options(args), latency=args.latency, gyr_samples=args.gyr_samples,
+                      acc_samples=args.acc_samples)
     if args.json:
         print(json.dumps(result, indent=2))
         return 0
@@ -367,7 +373,7 @@ def cmd_plot(args) -> int:
     _check_out(args.out, args.file, figure=True)
     result = plot_recording(args.file, args.out, args.method, dict(args.param), args.offline,
                             args.gyro_offset == "on", args.heading == "mag", _read_options(args), args.latency,
-                            args.gyr_samples)
+                            args.gyr_samples, args.acc_samples)
     if not result:
         print(f"attitude: wrote {args.out} (no reference to measure errors against: the estimate's roll, pitch "
               "and yaw over time)", file=sys.stderr)

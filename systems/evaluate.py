@@ -10,7 +10,7 @@ from dataclasses import replace
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from blocks.timing import carry_forward_rows, interval_means
+from blocks.timing import carry_forward_rows, interval_ends, interval_means
 
 from .batch import check_options, estimate
 from .compare import peer_quaternions
@@ -93,24 +93,27 @@ def evaluate_recording(rec: Recording, method: str = "wiener", params=None, offl
 
 def evaluate(paths, method: str = "wiener", params=None, offline: bool = False, gyro_offset: bool = True,
              use_mag: bool = True, progress: bool = True, start_in_movement: float | None = None,
-             read_options=None, latency: float = 0.0, gyr_samples: str = "mean") -> dict:
+             read_options=None, latency: float = 0.0, gyr_samples: str = "mean", acc_samples: str = "point") -> dict:
     """{"recordings": {name: {label: metrics}}, "mean": {label: metrics}, "imu_latency_s":
     {name: seconds or None}} over the files (imu_latency: the IMU's delay behind the
     reference, measured, whatever latency (s) the estimates were carried forward by);
     gyr_samples "point": every recording's gyro is turned into interval means first
     (blocks.timing.interval_means), for the peers and the latency measured as well;
+    acc_samples "mean": every accelerometer mean is turned into the sensor frame at its
+    sample's time first (blocks.timing.interval_ends), for the peers as well;
     start_in_movement (s): cut each recording to begin that long into its movement phase;
     read_options: keyword arguments of read_recording (units, fs, max_gap). Every file is
     read and checked first. A recording's name is its file's stem, or its path where
     stems repeat. progress also prints how each file was read where it matters (time
     stamps, no movement flag)."""
-    check_options(method, params, offline, gyro_offset, use_mag, latency, gyr_samples)
-    point = gyr_samples == "point"
+    check_options(method, params, offline, gyro_offset, use_mag, latency, gyr_samples, acc_samples)
     read = []  # every file read and checked before any estimate: a bad last file costs nothing
     for path in paths:
         rec = read_recording(path, **(read_options or {}))
-        if point:
+        if gyr_samples == "point":
             rec = replace(rec, gyr=interval_means(rec.gyr))
+        if acc_samples == "mean":
+            rec = replace(rec, acc=interval_ends(rec.gyr, rec.acc, 1.0 / rec.fs))
         if start_in_movement is not None:
             rec = rec.into_movement(start_in_movement)
         rec.evaluated()

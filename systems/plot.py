@@ -19,7 +19,7 @@ from .recording import RecordingError, euler_degrees, print_notes, read_recordin
 
 def plot_recording(path, out, method: str = "wiener", params=None, offline: bool = False,
                    gyro_offset: bool = True, heading: bool = True, read_options=None, latency: float = 0.0,
-                   gyr_samples: str = "mean") -> dict:
+                   gyr_samples: str = "mean", acc_samples: str = "point") -> dict:
     """Draw the error of method on a recording with a reference into out (PNG): the
     inclination error over time, with heading (and a magnetometer in the recording) the
     heading error with the samples the disturbance guard refused shaded and the times a
@@ -28,13 +28,13 @@ def plot_recording(path, out, method: str = "wiener", params=None, offline: bool
     movement phase (Recording.evaluated). A recording without a reference gets the
     estimate's roll, pitch and yaw over time instead (and the gyro offset estimate), and
     an empty dict. read_options: keyword arguments of read_recording (its notes go to
-    standard error); latency (s) and gyr_samples: as systems.batch.estimate's."""
+    standard error); latency (s), gyr_samples and acc_samples: as systems.batch.estimate's."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    check_options(method, params, offline, gyro_offset, heading, latency, gyr_samples)
+    check_options(method, params, offline, gyro_offset, heading, latency, gyr_samples, acc_samples)
     rec = read_recording(path, **(read_options or {}))
     print_notes(rec.notes)
     valid = None if rec.quat_ref is None else rec.evaluated()
@@ -42,7 +42,7 @@ def plot_recording(path, out, method: str = "wiener", params=None, offline: bool
         raise RecordingError(f"{rec.name}: too few valid reference samples to plot")
     mag = rec.mag if heading else None
     est = estimate(rec.gyr, rec.acc, rec.fs, method, params, offline=offline, gyro_offset=gyro_offset, mag=mag,
-                   latency=latency, gyr_samples=gyr_samples)
+                   latency=latency, gyr_samples=gyr_samples, acc_samples=acc_samples)
     label = f"{method}{' --offline' if offline else ''}{f' --latency {latency:g}' if latency else ''}"
     t = np.arange(1, len(rec.gyr) + 1) / rec.fs
     if valid is None:

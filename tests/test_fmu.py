@@ -83,15 +83,16 @@ def test_every_fmu_validates(fmu_dir):
         assert validate_fmu(str(fmu_dir / f"{name}.fmu")) == [], name
 
 
-@pytest.mark.parametrize("latency, gyr_samples", [(0.0, "mean"), (0.004, "point")])
+@pytest.mark.parametrize("latency, gyr_samples, acc_samples", [(0.0, "mean", "point"), (0.004, "point", "mean")])
 @pytest.mark.parametrize("method", sorted(METHODS))
-def test_estimator_fmu_equals_the_batch_path(fmu_dir, recording, method, latency, gyr_samples):
+def test_estimator_fmu_equals_the_batch_path(fmu_dir, recording, method, latency, gyr_samples, acc_samples):
     gyr, acc = recording
     params = {"delta_n": 0.002} if any(p.name == "delta_n" for p in METHODS[method].params) else {}
-    runner = _estimator(fmu_dir, method=method, latency=latency, gyr_samples=gyr_samples, **params)
+    runner = _estimator(fmu_dir, method=method, latency=latency, gyr_samples=gyr_samples, acc_samples=acc_samples,
+                        **params)
     out, valid = runner.run(np.hstack([gyr, acc]), 1 / FS)
     runner.close()
-    ref = estimate(gyr, acc, FS, method, params, latency=latency, gyr_samples=gyr_samples)
+    ref = estimate(gyr, acc, FS, method, params, latency=latency, gyr_samples=gyr_samples, acc_samples=acc_samples)
     assert valid.all()
     assert np.abs(out[:, :4] - ref.quat).max() < 1e-9
     assert np.abs(out[:, 4:] - ref.up).max() < 1e-9
@@ -326,6 +327,7 @@ def test_estimator_fmu_takes_a_zero_where_zero_is_a_setting(fmu_dir, recording, 
     ({"gyro_offset": "yes"}, "gyro_offset must be 'on' or 'off'"),
     ({"latency": 1.0}, "latency must be a finite number of seconds within"),
     ({"gyr_samples": "midpoint"}, "gyr_samples must be 'mean' or 'point'"),
+    ({"acc_samples": "end"}, "acc_samples must be 'point' or 'mean'"),
 ])
 def test_invalid_parameter_ends_initialisation_in_fmi2_error(fmu_dir, parameters, message, capsys):
     """The model logs the error (a Python exception would end in fmi2Fatal and corrupt the
