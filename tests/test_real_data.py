@@ -322,68 +322,52 @@ def test_latency_carries_a_delayed_imu_onto_the_motion(offline):
     assert errors[delay] == pytest.approx(left, rel=0.1) and errors[delay] < 0.03 * errors[0.0]
 
 
-def test_point_samples_of_the_rate_are_turned_into_interval_means():
-    """A simulation that samples ω(t_k) and f(t_k) (not the means over each sample time)
-    of a ±10° pitch at 0.5 Hz (Ω = π rad/s), 100 Hz: integrated as means, the gyro's
-    frame leads by Ts/2 and the filter (eq. 34 at ω_g = 1 rad/s) passes that lead on
-    through its complementary high-pass 1 − B(jΩ): a tilt RMS of |1 − B(jΩ)|·|ω|·Ts/2
-    (within 3 %). With gyr_samples "point" it is under 2 % of that; vqf, reading them as
-    means, keeps an error of that order. imu_latency sees the samples Ts/2 ahead of the
-    reference, and on time once turned into means."""
-    motion = PROFILES["sine_rotation"].motion({"inclination_deg": 20.0})
-    t = np.arange(1, int(60 * FS) + 1) / FS
-    gyr, acc, quat = motion.at(t, 1e-7)  # the rate and specific force at t_k
-    up = Rotation.from_quat(quat, scalar_first=True).inv().apply([0.0, 0.0, 1.0])
-    settled = slice(int(20 * FS), None)
-    params = {"omega_g": 1.0}
-    errors = {samples: rms(inclination_error(estimate(gyr, acc, FS, params=params, gyr_samples=samples).up[settled],
-                                             up[settled])) for samples in ("mean", "point")}
-    s = 1j * math.pi
-    passed = abs(1.0 - 1.0 / (s * s + math.sqrt(2.0) * s + 1.0))
-    lead = passed * rms(np.linalg.norm(gyr[settled], axis=1) / FS / 2)
-    print(f"tilt RMS: point samples as means {math.degrees(errors['mean']):.4f}° (|1 − B|·|ω|·Ts/2 "
-          f"{math.degrees(lead):.4f}°), turned into means {math.degrees(errors['point']):.5f}°")
-    assert errors["mean"] == pytest.approx(lead, rel=0.03) and errors["point"] < 0.02 * lead
-    vqf_up = Rotation.from_quat(peer_quaternions("vqf", gyr, acc, FS), scalar_first=True).inv().apply([0, 0, 1.0])
-    vqf_error = rms(inclination_error(vqf_up[settled], up[settled]))
-    print(f"vqf, reading them as means: {math.degrees(vqf_error):.4f}°")
-    assert vqf_error > 0.5 * lead
-    rec = Recording("point", FS, gyr, acc, t, quat_ref=quat, movement=t > 20.0)
-    assert imu_latency(rec) == pytest.approx(-0.5 / FS, abs=1e-4)
-    assert imu_latency(replace(rec, gyr=interval_means(gyr))) == pytest.approx(0.0, abs=1e-4)
-
-
 def _mean_specific_force(motion, t, parts: int = 64):
     """The specific force of a closed-form motion averaged over each sample time (t_k − 1/FS,
     t_k] (midpoints of `parts` slices), as a sensor that averages it reads it (N×3, m/s²)."""
     return np.mean([motion.at(t - (j + 0.5) / (parts * FS), 1e-7)[1] for j in range(parts)], axis=0)
 
 
-def test_accelerometer_means_are_turned_to_the_sample_time():
-    """A sensor that averages the specific force over each sample time, as the gyro (a
-    recording averaged down to a lower rate), on the ±10° pitch at 0.5 Hz (Ω = π rad/s):
-    read as the force at t_k, gravity lags by |ω|·Ts/2, which the filter (eq. 34 at ω_g =
-    1 rad/s) passes through its low-pass B(jΩ): a tilt RMS of |B(jΩ)|·|ω|·Ts/2 (within
-    1 %). With acc_samples "mean" it is under 2 % of that; vqf, reading them as values at
-    t_k, keeps an error of that order."""
+@pytest.mark.parametrize("convention", ["gyr_samples", "acc_samples"])
+def test_samples_of_another_timing_are_turned_into_the_convention(convention):
+    """The ±10° pitch at 0.5 Hz (Ω = π rad/s) at 100 Hz sampled with another timing than
+    the project's, read as if it had it; the filter is eq. 34 at ω_g = 1 rad/s:
+    - gyro point samples, the rate at t_k (a simulation that samples ω(t_k)): integrated
+      as means, the gyro's frame leads by Ts/2, which the filter passes on through its
+      complementary high-pass 1 − B(jΩ);
+    - accelerometer means over each sample time (a recording averaged down): read as the
+      force at t_k, gravity lags by Ts/2, which the filter passes through its low-pass B(jΩ).
+    Either way a tilt RMS of that gain times |ω|·Ts/2 (within 3 %), under 2 % of it with
+    the convention given (gyr_samples "point", acc_samples "mean"); vqf, which reads
+    samples as the project does, keeps an error of that order. imu_latency sees point
+    samples of the rate Ts/2 ahead of the reference, and on time once turned into means."""
     motion = PROFILES["sine_rotation"].motion({"inclination_deg": 20.0})
     t = np.arange(1, int(60 * FS) + 1) / FS
-    gyr, _, quat = motion.at(t, 1 / FS)
-    acc = _mean_specific_force(motion, t)
+    s = 1j * math.pi
+    low_pass = 1.0 / (s * s + math.sqrt(2.0) * s + 1.0)
+    if convention == "gyr_samples":
+        gyr, acc, quat = motion.at(t, 1e-7)  # the rate and specific force at t_k
+        given, gain = "point", abs(1.0 - low_pass)
+    else:
+        gyr, _, quat = motion.at(t, 1 / FS)
+        acc, given, gain = _mean_specific_force(motion, t), "mean", abs(low_pass)
     up = Rotation.from_quat(quat, scalar_first=True).inv().apply([0.0, 0.0, 1.0])
     settled = slice(int(20 * FS), None)
-    errors = {samples: rms(inclination_error(estimate(gyr, acc, FS, params={"omega_g": 1.0},
-                                                      acc_samples=samples).up[settled], up[settled]))
-              for samples in ("point", "mean")}
-    s = 1j * math.pi
-    lag = abs(1.0 / (s * s + math.sqrt(2.0) * s + 1.0)) * rms(np.linalg.norm(gyr[settled], axis=1) / FS / 2)
-    print(f"tilt RMS: means read as values at t_k {math.degrees(errors['point']):.5f}° (|B|·|ω|·Ts/2 "
-          f"{math.degrees(lag):.5f}°), turned to t_k {math.degrees(errors['mean']):.6f}°")
-    assert errors["point"] == pytest.approx(lag, rel=0.01) and errors["mean"] < 0.02 * lag
+    errors = {told: rms(inclination_error(estimate(gyr, acc, FS, params={"omega_g": 1.0},
+                                                   **({convention: given} if told else {})).up[settled], up[settled]))
+              for told in (False, True)}
+    expected = gain * rms(np.linalg.norm(gyr[settled], axis=1) / FS / 2)
+    print(f"tilt RMS with {convention} {given} read as the convention {math.degrees(errors[False]):.5f}° "
+          f"(gain·|ω|·Ts/2 {math.degrees(expected):.5f}°), turned into it {math.degrees(errors[True]):.6f}°")
+    assert errors[False] == pytest.approx(expected, rel=0.03) and errors[True] < 0.02 * expected
     vqf_up = Rotation.from_quat(peer_quaternions("vqf", gyr, acc, FS), scalar_first=True).inv().apply([0, 0, 1.0])
     vqf_error = rms(inclination_error(vqf_up[settled], up[settled]))
-    print(f"vqf, reading them as values at t_k: {math.degrees(vqf_error):.5f}°")
-    assert vqf_error > 0.5 * lag
+    print(f"vqf: {math.degrees(vqf_error):.5f}°")
+    assert vqf_error > 0.5 * expected
+    if convention == "gyr_samples":
+        rec = Recording("point", FS, gyr, acc, t, quat_ref=quat, movement=t > 20.0)
+        assert imu_latency(rec) == pytest.approx(-0.5 / FS, abs=1e-4)
+        assert imu_latency(replace(rec, gyr=interval_means(gyr))) == pytest.approx(0.0, abs=1e-4)
 
 
 @pytest.mark.parametrize("flag, value", [("--gyr-samples", "point"), ("--acc-samples", "mean")])
