@@ -8,11 +8,11 @@ trapezoid, (ω_k−1 + ω_k)/2. Integrated as means, point samples lead the moti
 (on a ±10° pitch at 0.5 Hz sampled at 100 Hz, 0.12° of tilt RMS; tests/test_real_data.py).
 An accelerometer sample is the specific force at t_k (`acc_samples` "point", the
 convention's). One averaged over the sample time as the gyro is (a recording averaged
-down to a lower rate, an IMU whose filters treat both alike: `acc_samples` "mean") sees
-the sensor about Ts/2 earlier; it is turned into the sensor frame at t_k by the second
-half of the step's rotation, exp(−[ω]·Ts/2), the turn carry_forward gives the up-vector.
-Read as point values, such means lag by |ω|·Ts/2 of tilt, which the filter passes
-through its low-pass B.
+down to a lower rate, a sensor that averages both over each sample: `acc_samples`
+"mean") sees the sensor about Ts/2 earlier; it is turned into the sensor frame at t_k by
+the second half of the step's rotation, exp(−[ω]·Ts/2), the turn carry_forward gives the
+up-vector. Read as point values, such means lag by |ω|·Ts/2 of tilt, which the filter
+passes through its low-pass B.
 
 Latency: an IMU's samples lag the motion (the group delay of its digital filters, a few
 milliseconds), so an estimate made from them shows the orientation of that long ago.
