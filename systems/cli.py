@@ -113,6 +113,11 @@ def _add_input_flags(parser) -> None:
                              "measures it against the reference)")
 
 
+def _timing(args) -> dict:
+    """The sample-timing flags as keyword arguments of estimate, evaluate, plot and check_options."""
+    return {"latency": args.latency, "gyr_samples": args.gyr_samples, "acc_samples": args.acc_samples}
+
+
 def _read_options(args) -> dict:
     names = [name for name, _ in args.column]
     twice = sorted({name for name in names if names.count(name) > 1})
@@ -269,7 +274,7 @@ def cmd_estimate(args) -> int:
     from .batch import check_options
 
     check_options(args.method, dict(args.param), args.offline, args.gyro_offset == "on", args.heading == "mag",
-                  args.latency, args.gyr_samples, args.acc_samples)
+                  **_timing(args))
     outputs = _estimate_outputs(args.input, args.out)
     failed = []
     for number, (path, out) in enumerate(zip(args.input, outputs), 1):
@@ -306,7 +311,7 @@ def _estimate_one(args, path, out, prefix: str) -> None:
     print_notes(rec.notes + ([field_norm_note(rec)] if args.heading == "mag" else []))
     result = estimate(rec.gyr, rec.acc, rec.fs, args.method, dict(args.param), offline=args.offline,
                       gyro_offset=args.gyro_offset == "on", mag=rec.mag if args.heading == "mag" else None,
-                      latency=args.latency, gyr_samples=args.gyr_samples, acc_samples=args.acc_samples)
+                      **_timing(args))
     progress(f"estimated with {args.method}{' --offline' if args.offline else ''}")
     rows = slice(None) if rec.filled is None else ~rec.filled  # the input's rows, not those filled in
     extra = {}
@@ -350,8 +355,7 @@ def cmd_evaluate(args) -> int:
                            "install them with: pip install 'attitude-fmu[peers]'") from None
     result = evaluate(args.files, args.method, dict(args.param), args.offline, args.gyro_offset == "on",
                       args.heading == "mag", start_in_movement=args.start_in_movement,
-                      read_options=_read_options(args), latency=args.latency, gyr_samples=args.gyr_samples,
-                      acc_samples=args.acc_samples)
+                      read_options=_read_options(args), **_timing(args))
     if args.json:
         print(json.dumps(result, indent=2))
         return 0
@@ -372,8 +376,7 @@ def cmd_plot(args) -> int:
 
     _check_out(args.out, args.file, figure=True)
     result = plot_recording(args.file, args.out, args.method, dict(args.param), args.offline,
-                            args.gyro_offset == "on", args.heading == "mag", _read_options(args), args.latency,
-                            args.gyr_samples, args.acc_samples)
+                            args.gyro_offset == "on", args.heading == "mag", _read_options(args), **_timing(args))
     if not result:
         print(f"attitude: wrote {args.out} (no reference to measure errors against: the estimate's roll, pitch "
               "and yaw over time)", file=sys.stderr)
