@@ -89,6 +89,10 @@ NOISE_PARAMS = (
           f"slosh: density of the velocity of the motion (eq. 14); unset: {NOMINAL_DELTA_V:g} for the stationary filter"),
     Param("g", ef.STANDARD_GRAVITY, "m/s²", "magnitude of gravity"),
 )
+MAHONY_GAINS = (  # Mahony's filter, alone and in Tseng's adaptive switch
+    Param("k_P", 1.0, "1/s", "Mahony: proportional gain on the gravity-direction error"),
+    Param("k_I", 0.3, "1/s²", "Mahony: integral gain of the gyro-bias estimate; 0: no bias estimate", True),
+)
 LOCAL_NOISE_PARAMS = (
     Param("stationary", 0.0, "1", "0: omega_g from noise densities measured over the last tau_noise s "
           "(blocks.wiener_local); 1, or omega_g, omega_c or delta_v given: the stationary filter", True),
@@ -152,8 +156,7 @@ METHODS: dict[str, Method] = {
         "Tseng's adaptive filter: complementary filter, Mahony's filter while |acc| leaves g by > tol",
         (
             Param("tol", 0.5, "m/s²", "accelerometer norm's distance from g that switches to Mahony's filter"),
-            Param("k_P", 1.0, "1/s", "Mahony: proportional gain"),
-            Param("k_I", 0.3, "1/s²", "Mahony: integral gain of the gyro-bias estimate", True),
+            *MAHONY_GAINS,
             Param("g", ef.STANDARD_GRAVITY, "m/s²", "magnitude of gravity"),
         ),
         kernel=tseng_adaptive,
@@ -171,9 +174,7 @@ METHODS: dict[str, Method] = {
     "mahony": Method(
         "mahony",
         "Mahony's complementary filter on SO(3) with gyro-bias estimation (IEEE TAC 53, 2008)",
-        (
-            Param("k_P", 1.0, "1/s", "proportional gain on the gravity-direction error"),
-            Param("k_I", 0.3, "1/s²", "integral gain of the gyro-bias estimate; 0: no bias estimate", True),
+        MAHONY_GAINS + (
             Param("g", ef.STANDARD_GRAVITY, "m/s²", "magnitude of gravity (scales the gravity output)"),
         ),
         kernel=mahony,
