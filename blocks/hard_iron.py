@@ -36,7 +36,8 @@ mag_new_time old and
 (A younger window's fit is not yet sure enough to be left: its error where the sensor
 turns next alone exceeds the tolerance.)
 Soft iron (a scaled, skewed sphere) is not modelled. mag_cal_time = 0 switches the
-estimate off.
+estimate off. Offline, back_dated moves each offset taken or dropped back to where the
+field changed.
 """
 from __future__ import annotations
 
@@ -221,3 +222,37 @@ def hard_iron_step(state, coef, m, gap, norm_tol, steady_steps):
         state[FIT_STEPS] = 0.0
         state[RAW_STEPS] = 0.0
     return _less_offset(m, state), changed
+
+
+
+
+def back_dated(mag, offset, fs: float, params, steady_time: float) -> np.ndarray:
+    """The offset a forward pass used (N×3, field unit; blocks.heading.with_magnetometer)
+    with each change moved back to where the field changed, for a whole recording
+    offline. The pass proves an offset (taken, dropped: 0, or replaced: a step of more than
+    mag_cal_tol of the field's radius) only after the field has fitted it for steady_time
+    (s, the heading's mag_new_time). Between the previous change and this one, the field
+    is split where the samples before fit the sphere about the old offset and those after
+    the sphere about the new one best (least squares of the distances relative to the
+    radius, which hard iron does not change: the median distance from the new offset over
+    the steady_time that proved it). mag N×3 (rows with a NaN: no sample), params
+    resolved (PARAMS)."""
+    offset = np.array(offset, dtype=float)
+    rows = np.flatnonzero(np.isfinite(mag).all(axis=1))
+    used = offset.any(axis=1)
+    radius = np.median(np.linalg.norm(mag[rows] - offset[rows], axis=1)) if len(rows) else 0.0
+    steps = np.linalg.norm(np.diff(offset, axis=0), axis=1)
+    previous = 0
+    for k in np.flatnonzero((used[1:] != used[:-1]) | (steps > params["mag_cal_tol"] * radius)) + 1:
+        span = rows[(rows >= previous) & (rows < k)]
+        if len(span):
+            old, new = offset[k - 1], offset[k]
+            to_new = np.linalg.norm(mag[span] - new, axis=1)
+            proof = span >= k - steady_time * fs
+            r = np.median(to_new[proof] if proof.any() else to_new)
+            misfit_old = np.concatenate([[0.0], np.cumsum((np.linalg.norm(mag[span] - old, axis=1) / r - 1.0) ** 2)])
+            misfit_new = np.concatenate([np.cumsum(((to_new / r - 1.0) ** 2)[::-1])[::-1], [0.0]])
+            split = int(np.argmin(misfit_old + misfit_new))  # span[:split] keep the old offset
+            offset[span[split] if split < len(span) else k:k] = new
+        previous = k
+    return offset

@@ -11,6 +11,7 @@ from scipy.spatial.transform import Rotation
 
 from blocks import gyro_offset as offset_stage, heading as heading_stage
 from blocks.gyro_offset import correct as correct_gyro
+from blocks.hard_iron import back_dated
 from blocks.heading import with_magnetometer
 from blocks.timing import carry_forward_rows, check_latency, check_samples, interval_ends, interval_means
 from blocks.stages import split_params
@@ -104,7 +105,10 @@ def estimate(
     heading is the gyro's (6D). The magnetometer's delay behind the gyro, unless given as
     the parameter mag_delay, is estimated online by the heading stage (blocks.mag_delay),
     or offline measured from the whole recording (systems.delays.mag_delay; 0 where it
-    cannot be or comes out negative); `mag_delay` holds it per sample. latency (s):
+    cannot be or comes out negative); `mag_delay` holds it per sample. Offline, each
+    hard-iron offset the heading stage took or dropped holds from where the field changed
+    (blocks.hard_iron.back_dated), and the stage runs again on the field freed of it.
+    latency (s):
     the IMU's delay behind the motion; the estimate is carried forward over it with the
     (offset-free) gyro (blocks.timing).
     gyr_samples: "mean" (the project's convention: sample k is the mean rate over the
@@ -171,7 +175,16 @@ def _with_heading(est: AttitudeEstimate, mag, gyr, fs: float, params, offline: b
     est.mag_delay_source = "given" if params.get("mag_delay") is not None else "measured" if offline else "online"
     if est.mag_delay_source == "measured":
         params = {**params, "mag_delay": max(mag_delay(gyr, mag, fs) or 0.0, 0.0)}
-    est.quat, est.mag_accepted, est.mag_offset, est.mag_delay = with_magnetometer(est.quat, mag, fs, params)
+    quat = est.quat
+    est.quat, est.mag_accepted, est.mag_offset, est.mag_delay = with_magnetometer(quat, mag, fs, params)
+    if offline and est.mag_offset.any():  # again, with each hard-iron offset from where the field changed
+        resolved = heading_stage.resolve(params)
+        est.mag_offset = back_dated(mag, est.mag_offset, fs, resolved, resolved["mag_new_time"])
+        freed = mag - est.mag_offset
+        if est.mag_delay_source == "measured":  # the offset no longer hides the delay
+            params = {**params, "mag_delay": max(mag_delay(gyr, freed, fs) or 0.0, 0.0)}
+        est.quat, est.mag_accepted, _, est.mag_delay = with_magnetometer(quat, freed, fs,
+                                                                         {**params, "mag_cal_time": 0.0})
     return est
 
 
