@@ -224,8 +224,6 @@ def hard_iron_step(state, coef, m, gap, norm_tol, steady_steps):
     return _less_offset(m, state), changed
 
 
-
-
 def back_dated(mag, offset, fs: float, params, steady_time: float) -> np.ndarray:
     """The offset a forward pass used (N×3, field unit; blocks.heading.with_magnetometer)
     with each change moved back to where the field changed, for a whole recording
