@@ -224,17 +224,17 @@ def hard_iron_step(state, coef, m, gap, norm_tol, steady_steps):
     return _less_offset(m, state), changed
 
 
-def back_dated(mag, offset, fs: float, params, steady_time: float) -> np.ndarray:
+def back_dated(mag, offset, fs: float, params) -> np.ndarray:
     """The offset a forward pass used (N×3, field unit; blocks.heading.with_magnetometer)
     with each change moved back to where the field changed, for a whole recording
     offline. The pass proves an offset (taken, dropped: 0, or replaced: a step of more than
-    mag_cal_tol of the field's radius) only after the field has fitted it for steady_time
-    (s, the heading's mag_new_time). Between the previous change and this one, the field
+    mag_cal_tol of the field's radius) only after the field has fitted it for the heading's
+    mag_new_time (s). Between the previous change and this one, the field
     is split where the samples before fit the sphere about the old offset and those after
     the sphere about the new one best (least squares of the distances relative to the
     radius, which hard iron does not change: the median distance from the new offset over
-    the steady_time that proved it). mag N×3 (rows with a NaN: no sample), params
-    resolved (PARAMS)."""
+    the mag_new_time that proved it). mag N×3 (rows with a NaN: no sample), params the
+    heading stage's, resolved (blocks.heading.resolve)."""
     offset = np.array(offset, dtype=float)
     rows = np.flatnonzero(np.isfinite(mag).all(axis=1))
     used = offset.any(axis=1)
@@ -246,7 +246,7 @@ def back_dated(mag, offset, fs: float, params, steady_time: float) -> np.ndarray
         if len(span):
             old, new = offset[k - 1], offset[k]
             to_new = np.linalg.norm(mag[span] - new, axis=1)
-            proof = span >= k - steady_time * fs
+            proof = span >= k - params["mag_new_time"] * fs
             r = np.median(to_new[proof] if proof.any() else to_new)
             misfit_old = np.concatenate([[0.0], np.cumsum((np.linalg.norm(mag[span] - old, axis=1) / r - 1.0) ** 2)])
             misfit_new = np.concatenate([np.cumsum(((to_new / r - 1.0) ** 2)[::-1])[::-1], [0.0]])

@@ -178,8 +178,7 @@ def _with_heading(est: AttitudeEstimate, mag, gyr, fs: float, params, offline: b
     quat = est.quat
     est.quat, est.mag_accepted, est.mag_offset, est.mag_delay = with_magnetometer(quat, mag, fs, params)
     if offline and est.mag_offset.any():  # again, with each hard-iron offset from where the field changed
-        resolved = heading_stage.resolve(params)
-        est.mag_offset = back_dated(mag, est.mag_offset, fs, resolved, resolved["mag_new_time"])
+        est.mag_offset = back_dated(mag, est.mag_offset, fs, heading_stage.resolve(params))
         freed = mag - est.mag_offset
         if est.mag_delay_source == "measured":  # the offset no longer hides the delay
             params = {**params, "mag_delay": max(mag_delay(gyr, freed, fs) or 0.0, 0.0)}
