@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 
-from .jit import kernel
+from attitude_fmu.blocks.jit import kernel
 
 SERIES_ANGLE2 = 1e-2  # (rad)²: below it the half-angle series to θ⁸ is exact to double precision
 

@@ -2,37 +2,52 @@
 
 Each doStep(t, h) takes gyr (mean rate over (t, t+h], or with gyr_samples "point" the
 rate at t+h) and acc, mag at t+h, and steps the
-same compiled block as `attitude estimate` (blocks.online.OnlineEstimator). The tuning
+same pipeline as `attitude estimate` (blocks.pipeline.online.OnlineEstimator). The tuning
 parameters are those of every method and of the gyro-offset and heading estimators
-(blocks.stages). A parameter at its start value means "the default": the start value is
-0, or the default itself for a parameter that 0 sets to something (scale_error 0: no
-scale term, k_I 0: no bias estimate, tau_motion 0: no offset tracking while moving,
-mag_cal_time 0: no hard-iron fit, mag_new_angle 0: no turn needed). Parameters of a
-method or estimator that does not run must stay at their start values.
+(blocks.pipeline.causal). Each starts at its default, so an importer shows the values the
+FMU runs with; one whose default is derived from others, or differs between the methods
+that share its name, starts at NaN, "unset" (its description says what that means).
+Parameters of a method or estimator that does not run must stay at their start values.
 """
 from __future__ import annotations
 
 import math
 
-from fmu_support import IN, OUT, PAR, Fmi2Status, ProjectSlave, fmi_unit
-
-from blocks.methods import METHODS
-from blocks.online import OnlineEstimator, same_step
-from blocks.stages import ESTIMATORS
+from attitude_fmu.blocks.methods.registry import METHODS
+from attitude_fmu.blocks.pipeline.causal import ESTIMATORS
+from attitude_fmu.blocks.pipeline.online import OnlineEstimator, same_step
+from attitude_fmu.fmu_src.fmu_support import IN, OUT, PAR, Fmi2Status, ProjectSlave, fmi_unit
 
 
 def tuning_parameters():
     """Every method's tuning parameters and those of the gyro-offset and heading
-    estimators, once each: name → (FMI unit, description, start value meaning the
-    default; see the module docstring)."""
-    params = {}
-    for stage in (*(m.params for m in METHODS.values()), *ESTIMATORS.values()):
+    estimators, once each: name → (FMI unit, description, start value). The start value is
+    the default where every stage with the name has that one default, else NaN: unset."""
+    found = {}
+    for owner, stage in (*((f"method {m.name}", m.params) for m in METHODS.values()), *ESTIMATORS.items()):
         for p in stage:
-            start = p.default if p.allow_zero and p.default else 0.0
-            doc = f"{p.doc}; default {start:g}" if start else f"{p.doc}; 0: the default"
-            if params.setdefault(p.name, (fmi_unit(p.unit), doc, start))[2] != start:
-                raise ValueError(f"parameter {p.name} needs one start value in every stage")
+            found.setdefault(p.name, []).append((owner, p))
+    params = {}
+    for name, uses in found.items():
+        first = uses[0][1]
+        defaults = {p.default for _, p in uses}
+        if len(defaults) == 1 and first.default is not None:
+            params[name] = (fmi_unit(first.unit), f"{first.doc}; default {first.default:g}", first.default)
+            continue
+        if defaults == {None}:
+            doc = f"{first.doc}; NaN (the start value): unset"
+        else:
+            each = "; ".join(f"{owner}: {'unset' if p.default is None else format(p.default, 'g')}" for owner, p in uses)
+            doc = f"{first.doc}; NaN (the start value): the default of the stage that runs ({each})"
+        params[name] = (fmi_unit(first.unit), doc, math.nan)
     return params
+
+
+def overrides(values) -> dict:
+    """The tuning parameters (name → value) that differ from their start values: those the
+    estimator is given (NaN, unset, is never given)."""
+    return {name: values[name] for name, (_, _, start) in tuning_parameters().items()
+            if not math.isnan(values[name]) and values[name] != start}
 
 
 class AttitudeEstimator(ProjectSlave):
@@ -85,8 +100,7 @@ class AttitudeEstimator(ProjectSlave):
         if self.gyro_offset not in ("on", "off"):
             self.fail(f"invalid parameter: gyro_offset must be 'on' or 'off', got {self.gyro_offset!r}")
             return
-        params = {name: getattr(self, name) for name, (_, _, start) in tuning_parameters().items()
-                  if getattr(self, name) != start}
+        params = overrides({name: getattr(self, name) for name in tuning_parameters()})
         try:
             self.estimator = OnlineEstimator(self.method, params, heading=self.heading == "mag",
                                              gyro_offset=self.gyro_offset == "on", latency=self.latency,
@@ -103,20 +117,20 @@ class AttitudeEstimator(ProjectSlave):
             self._warned_step = True  # a master with variable steps would log every one
             self.log(f"communication step {step_size:g} s differs from Ts = {self.Ts:g} s: filter re-discretised "
                      "for it (and, without further warnings, for every other step size)", Fmi2Status.warning)
-        io = self.estimator.io
-        io[0], io[1], io[2] = self.gyr_x, self.gyr_y, self.gyr_z
-        io[3], io[4], io[5] = self.acc_x, self.acc_y, self.acc_z
-        io[16], io[17], io[18] = self.mag_x, self.mag_y, self.mag_z
+        gyr = (self.gyr_x, self.gyr_y, self.gyr_z)
+        acc = (self.acc_x, self.acc_y, self.acc_z)
         try:
-            self.valid = self.estimator.step_io(step_size)
+            self.valid = self.estimator.step(gyr, acc, step_size, (self.mag_x, self.mag_y, self.mag_z))
         except ValueError as exc:
             return self.fail(str(exc))
         if self.valid:
-            (self.q_w, self.q_x, self.q_y, self.q_z, self.g_x, self.g_y, self.g_z,
-             self.roll, self.pitch, self.yaw) = io[6:16].tolist()
-            self.gyr_offset_x, self.gyr_offset_y, self.gyr_offset_z = self.estimator.offset[0].tolist()
-            self.mag_offset_x, self.mag_offset_y, self.mag_offset_z = self.estimator.mag_offset.tolist()
-            self.mag_delay_used = self.estimator.mag_delay
-        elif not all(math.isfinite(v) for v in io[0:6].tolist()):
+            est = self.estimator
+            self.q_w, self.q_x, self.q_y, self.q_z = est.quat.tolist()
+            self.g_x, self.g_y, self.g_z = est.up.tolist()
+            self.roll, self.pitch, self.yaw = est.euler.tolist()
+            self.gyr_offset_x, self.gyr_offset_y, self.gyr_offset_z = est.offset.tolist()
+            self.mag_offset_x, self.mag_offset_y, self.mag_offset_z = est.mag_offset.tolist()
+            self.mag_delay_used = est.mag_delay
+        elif not all(math.isfinite(v) for v in gyr + acc):
             self.log(f"t={current_time:g}: non-finite input; estimate held", Fmi2Status.warning)
         return True

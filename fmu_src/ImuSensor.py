@@ -1,4 +1,4 @@
-"""ImuSensor.fmu: ideal motion signals in, measured IMU signals out (systems.sensor_model.ImuModel).
+"""ImuSensor.fmu: ideal motion signals in, measured IMU signals out (systems.simulation.sensor_model.ImuModel).
 
 Noise is drawn per step from numpy's generator seeded with `seed`, in the order the
 batch path draws it, so a run equals ImuModel.apply on the same samples; the
@@ -12,11 +12,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from fmu_support import IN, OUT, PAR, Integer, ProjectSlave
 
-from blocks.online import same_step
-from systems.motion import EARTH_FIELD_UT
-from systems.sensor_model import ImuModel, mag_noise_generator
+from attitude_fmu.blocks.stages.timing import same_step
+from attitude_fmu.fmu_src.fmu_support import IN, OUT, PAR, Integer, ProjectSlave
+from attitude_fmu.systems.simulation.motion import EARTH_FIELD_UT
+from attitude_fmu.systems.simulation.sensor_model import ImuModel, mag_noise_generator
 
 
 class ImuSensor(ProjectSlave):

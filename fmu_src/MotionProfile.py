@@ -1,16 +1,15 @@
-"""MotionProfile.fmu: the project's motion profiles with exact truth (systems.motion).
+"""MotionProfile.fmu: the project's motion profiles with exact truth (systems.simulation.motion).
 
 Each doStep(t, h) outputs the interval (t, t+h]: the mean angular rate over it, and the
 specific force, magnetic field and true orientation at t+h. Profile parameters are
-named <profile>_<parameter>; 0 means the profile's default.
+named <profile>_<parameter> and start at the profile's defaults.
 """
 from __future__ import annotations
 
-from fmu_support import OUT, PAR, Integer, ProjectSlave, fmi_unit
 from scipy.spatial.transform import Rotation
 
-from systems.motion import EARTH_FIELD_UT, PROFILES, profile
-
+from attitude_fmu.fmu_src.fmu_support import OUT, PAR, Integer, ProjectSlave, fmi_unit
+from attitude_fmu.systems.simulation.motion import EARTH_FIELD_UT, PROFILES, profile
 
 
 class MotionProfile(ProjectSlave):
@@ -30,14 +29,13 @@ class MotionProfile(ProjectSlave):
         self.real("g", 9.81, "m/s2", "magnitude of gravity", PAR)
         for prof in PROFILES.values():
             for p in prof.params:
-                self.real(f"{prof.name}_{p.name}", 0.0, fmi_unit(p.unit), f"{prof.name}: {p.doc}; 0: default {p.default:g}", PAR)
+                self.real(f"{prof.name}_{p.name}", p.default, fmi_unit(p.unit), f"{prof.name}: {p.doc}", PAR)
         self.stream = None
 
     def initialise(self):
         try:
             prof = profile(self.profile)
-            overrides = {p.name: getattr(self, f"{prof.name}_{p.name}") for p in prof.params}
-            motion = prof.motion({k: v for k, v in overrides.items() if v != 0.0}, g=self.g)
+            motion = prof.motion({p.name: getattr(self, f"{prof.name}_{p.name}") for p in prof.params}, g=self.g)
             self.stream = motion.stream(self.seed)
             # a closed-form motion leaves no state when stepped (and pickle cannot hold its functions)
             self.internal_state = () if self.stream is motion else ("stream",)

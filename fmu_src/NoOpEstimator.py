@@ -4,7 +4,7 @@ Built only by the FMU benchmark, to measure what the FMI plumbing alone costs pe
 """
 from __future__ import annotations
 
-from AttitudeEstimator import AttitudeEstimator
+from attitude_fmu.fmu_src.AttitudeEstimator import AttitudeEstimator
 
 
 class NoOpEstimator(AttitudeEstimator):

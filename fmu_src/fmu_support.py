@@ -1,5 +1,6 @@
-"""FMI plumbing shared by the project's FMUs (pythonfmu): units on Real variables, the
-UnitDefinitions they refer to, and compact registration of variables.
+"""FMI plumbing shared by the project's pythonfmu FMUs: units on Real variables, the
+UnitDefinitions they refer to, compact registration of variables, and the check that the
+attitude_fmu code a process runs is the FMU's own.
 
 The models' equations live in `blocks/` and `systems/`; an FMU here only maps FMI
 variables onto them.
@@ -8,6 +9,8 @@ from __future__ import annotations
 
 import copy
 import hashlib
+import importlib.util
+import math
 import pickle
 import sys
 from pathlib import Path
@@ -38,45 +41,68 @@ UNITS = {
 
 
 IN, OUT, PAR = Fmi2Causality.input, Fmi2Causality.output, Fmi2Causality.parameter
-PROJECT_PACKAGES = ("blocks", "systems")  # carried in every FMU's resources
+PACKAGE = "attitude_fmu"  # the modules of it an FMU imports are in its resources, under this name
 INTERNAL_STATE = " internal"  # key of a saved FMU state's model part (no variable name has a space)
-_loaded_digests: dict[Path, str] = {}  # folder this process's project code came from → its code_digest
+_file_digests: dict[Path, str] = {}  # source file → SHA-256 of its contents, taken the first time it is read
 
 
-def code_digest(root) -> str:
-    """SHA-256 over the project's packages under the folder root: the relative paths and
-    contents of their .py files."""
+def code_digest(root, files) -> str:
+    """SHA-256 over the files (paths relative to the folder root): their paths and contents;
+    a file root does not have counts as empty."""
     root = Path(root)
     digest = hashlib.sha256()
-    for package in PROJECT_PACKAGES:
-        for path in sorted((root / package).rglob("*.py")):
-            digest.update(f"{path.relative_to(root).as_posix()}\0".encode())
-            digest.update(path.read_bytes())
+    for relative in sorted(files):
+        digest.update(f"{relative}\0".encode())
+        path = root / relative
+        digest.update(path.read_bytes() if path.is_file() else b"\0missing")
     return digest.hexdigest()
+
+
+def _file_digest(path: Path) -> str | None:
+    """The digest of a source file's contents, remembered: an importer may delete an FMU's
+    folder when it is done with it while its modules stay loaded. None: gone unread."""
+    if path not in _file_digests:
+        if not path.is_file():
+            return None
+        _file_digests[path] = hashlib.sha256(path.read_bytes()).hexdigest()
+    return _file_digests[path]
+
+
+def _origin(module: str) -> Path | None:
+    """The file this process runs a module from: the loaded one, else the one an import would load."""
+    loaded = sys.modules.get(module)
+    if loaded is not None:
+        return Path(loaded.__file__).resolve() if getattr(loaded, "__file__", None) else None
+    try:
+        spec = importlib.util.find_spec(module)
+    except ImportError:
+        return None
+    return Path(spec.origin).resolve() if spec is not None and spec.origin else None
 
 
 def foreign_code(resources) -> str | None:
     """Why an FMU whose resources folder is resources cannot run in this process, or None.
-    Python keeps one copy of a module per process: if the project's packages were imported
-    before this FMU from other sources (another FMU's build, an installed version of the
-    project), the FMU would run that code. The loaded copy's digest is taken the first time
-    (an importer may delete an FMU's folder when it is done with it)."""
-    loaded = sys.modules.get(PROJECT_PACKAGES[0])
-    if resources is None or loaded is None:
+
+    An FMU carries the modules of attitude_fmu it imports, as packages without an
+    __init__.py (namespace packages), so that FMUs of one build loaded into one process
+    (each carrying its own part) share one package. Python keeps one copy of a module per
+    process: if a module was imported from other sources (an FMU of another build, an
+    installed attitude_fmu of another version), this FMU would run that code; it is
+    refused instead."""
+    if resources is None:
         return None
-    source = Path(loaded.__file__).resolve().parent.parent
-    own = code_digest(resources)
-    if source not in _loaded_digests:
-        if source == Path(resources).resolve():
-            _loaded_digests[source] = own
-        elif (source / PROJECT_PACKAGES[0]).is_dir():
-            _loaded_digests[source] = code_digest(source)
-        else:
-            return None  # gone before anything could compare with it
-    if _loaded_digests[source] == own:
-        return None
-    return (f"this FMU's code differs from the attitude-fmu code this process imported before it, from {source}; "
-            "a process holds one copy of it: run FMUs of one build together, or each in a process of its own")
+    own_root = Path(resources) / PACKAGE
+    for path in sorted(own_root.rglob("*.py")):
+        module = ".".join((PACKAGE, *path.relative_to(own_root).with_suffix("").parts))
+        origin = _origin(module)
+        if origin is None or origin == path.resolve():
+            continue
+        theirs = _file_digest(origin)
+        if theirs is not None and theirs != _file_digest(path.resolve()):
+            return (f"this FMU's code differs from the attitude-fmu code this process imported before it ({module} "
+                    f"from {origin}); "
+                    "a process holds one copy of it: run FMUs of one build together, or each in a process of its own")
+    return None
 
 
 def fmi_unit(unit: str) -> str:
@@ -98,7 +124,10 @@ class UnitReal(Real):
 
     def to_xml(self) -> Element:
         node = super().to_xml()
-        node.find("Real").set("unit", self.unit)
+        real = node.find("Real")
+        real.set("unit", self.unit)
+        if self.start is not None:  # exactly (pythonfmu writes 16 digits), and NaN as XML Schema spells it
+            real.set("start", "NaN" if math.isnan(self.start) else repr(float(self.start)))
         return node
 
 

@@ -1,6 +1,6 @@
 """End the test process right after pytest has reported when FMUs were loaded in it:
 pythonfmu's export library finalises its embedded Python state from a library destructor,
-which can crash at interpreter shutdown after every test has run (systems.cosim.fmus_loaded)."""
+which can crash at interpreter shutdown after every test has run (systems.fmi.cosim.fmus_loaded)."""
 import os
 import sys
 
@@ -10,7 +10,7 @@ def pytest_sessionfinish(session, exitstatus):
 
 
 def pytest_unconfigure(config):
-    from systems.cosim import fmus_loaded
+    from attitude_fmu.systems.fmi.cosim import fmus_loaded
 
     status = getattr(config, "attitude_exit_status", None)
     if status is not None and fmus_loaded():

@@ -4,10 +4,10 @@ import math
 import numpy as np
 import pytest
 
-from blocks import accuracy as ac
-from blocks import earth_filters as ef
-from blocks.methods import METHODS, method
-from systems.experiments import PAPER_G, TABLE1_ROWS, TABLE1_SLOSH
+from attitude_fmu.blocks.filters import accuracy as ac
+from attitude_fmu.blocks.filters import earth_filters as ef
+from attitude_fmu.blocks.methods.registry import METHODS, method
+from attitude_fmu.systems.evaluation.experiments import PAPER_G, TABLE1_ROWS, TABLE1_SLOSH
 
 # Table 1 as printed: 1/ω_g (s) and ΔΩ_RMS (°) for a = 1, 0.5, 2
 PRINTED = {

@@ -5,11 +5,12 @@ import math
 import numpy as np
 import pytest
 
-from systems.axes import MAPS, axes_text, parse_axes
-from systems.cli import main
-from systems.motion import PROFILES, HumanMotion
-from systems.recording import IMU_COLUMNS, MAG_COLUMNS, read_recording
-from systems.sensor_model import ImuModel
+from attitude_fmu.systems.cli.commands import main
+from attitude_fmu.systems.recordings.axes import MAPS, axes_text, parse_axes
+from attitude_fmu.systems.recordings.reading import read_recording
+from attitude_fmu.systems.recordings.recording import IMU_COLUMNS, MAG_COLUMNS
+from attitude_fmu.systems.simulation.motion import PROFILES, HumanMotion
+from attitude_fmu.systems.simulation.sensor_model import ImuModel
 
 FS = 100.0
 

@@ -9,12 +9,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from blocks.timing import interval_ends
-from systems.batch import estimate
-from systems.compare import peer_quaternions
-from systems.delays import mag_delay
-from systems.evaluate import errors_on_movement, evaluate
-from systems.recording import read_recording
+from attitude_fmu.blocks.pipeline.batch import estimate
+from attitude_fmu.blocks.stages.delays import mag_delay
+from attitude_fmu.blocks.stages.timing import interval_ends
+from attitude_fmu.systems.evaluation.compare import peer_quaternions
+from attitude_fmu.systems.evaluation.evaluate import errors_on_movement, evaluate
+from attitude_fmu.systems.recordings.reading import read_recording
 
 BROAD = Path(os.environ.get("BROAD_DIR", Path(__file__).resolve().parents[1].parent / "shared" / "broad"))
 FILES = sorted(BROAD.glob("*.mat"))
@@ -73,7 +73,7 @@ def test_vqf_figures_are_the_wiener_filter_at_its_break_frequency(table):
 
 def test_a_constant_gyro_offset_added_to_the_recordings_changes_nothing():
     """Every recording begins at rest: the rest's gyro samples give the offset (their Kalman
-    mean, blocks.gyro_offset), so 1.4 °/s more offset leaves the inclination as it was."""
+    mean, blocks.stages.gyro_offset), so 1.4 °/s more offset leaves the inclination as it was."""
     added = np.radians([1.0, -0.5, 0.8])
     for path in FILES:
         rec = read_recording(path)
@@ -114,7 +114,7 @@ def test_recordings_averaged_down_to_48_hz_read_with_acc_samples_mean():
 
 def test_the_hard_iron_fit_takes_only_the_attached_magnet():
     """BROAD's magnetometers are calibrated: a sphere fit over whole rotation trials finds
-    0.3–3 µT, within the guard's norm tolerance, so blocks.hard_iron leaves them alone, the
+    0.3–3 µT, within the guard's norm tolerance, so blocks.stages.hard_iron leaves them alone, the
     stationary magnet's trial as well. In the attached-magnet trial the magnet is on the
     board from 38 s to 93 s (a sphere fit of 45–80 s, least squares over the whole span,
     gives its offset): that offset is taken while the magnet is on, and dropped after;
@@ -208,7 +208,7 @@ def test_the_imu_trails_the_reference_alike_in_every_file_and_latency_compensati
 
 
 def test_the_magnetometer_trails_the_gyro_alike_in_every_file_without_a_magnet_on_the_board():
-    """systems.delays.mag_delay, from the IMU's own data: one delay for the device (within
+    """blocks.stages.delays.mag_delay, from the IMU's own data: one delay for the device (within
     3 ms across the files), the magnetometer behind the gyro."""
     delays = {}
     for path in FILES:
@@ -222,8 +222,8 @@ def test_the_magnetometer_trails_the_gyro_alike_in_every_file_without_a_magnet_o
 
 
 def test_the_online_estimate_of_the_magnetometer_delay_agrees_with_the_whole_recording_measurement():
-    """blocks.mag_delay, as the default heading runs it: at the end of every file without
-    a magnet on the board, within 2 ms of systems.delays.mag_delay in the undisturbed
+    """blocks.stages.mag_delay, as the default heading runs it: at the end of every file without
+    a magnet on the board, within 2 ms of blocks.stages.delays.mag_delay in the undisturbed
     trials and within 4.5 ms in the disturbed ones (the vibrating phone's rate noise pulls
     it towards 0: 8.5 ms against 12.4 ms)."""
     for path in FILES:
@@ -237,12 +237,12 @@ def test_the_online_estimate_of_the_magnetometer_delay_agrees_with_the_whole_rec
 
 
 def test_the_recordings_axes_pass_the_axis_check_and_a_swapped_magnetometer_is_named():
-    """BROAD's sensors share their axes: no axis note on any recording (systems.axes). Its
+    """BROAD's sensors share their axes: no axis note on any recording (systems.recordings.axes). Its
     magnetometer read as an MPU-9250's (x, y swapped, z reversed) is named with the flag
     that maps it back in every trial that turns (rotation, combined, tapping, vibration, a
     magnet nearby); not in the translation trials, which turn too little to tell, nor
     where a magnet on the board outweighs the earth's field."""
-    from systems.axes import axes_notes, parse_axes
+    from attitude_fmu.systems.recordings.axes import axes_notes, parse_axes
 
     for path in FILES:
         rec = read_recording(path)

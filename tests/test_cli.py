@@ -8,13 +8,13 @@ import numpy as np
 import pytest
 from scipy.io import savemat
 
-from blocks.methods import METHODS
-from blocks.quaternion import quat_euler_zyx
-from systems.batch import estimate
-from systems.cli import main
-from systems.motion import HumanMotion
-from systems.recording import EULER_COLUMNS, OUTPUT_COLUMNS
-from systems.sensor_model import ImuModel
+from attitude_fmu.blocks.methods.registry import METHODS
+from attitude_fmu.blocks.pipeline.batch import estimate
+from attitude_fmu.blocks.quaternion import quat_euler_zyx
+from attitude_fmu.systems.cli.commands import main
+from attitude_fmu.systems.recordings.writing import EULER_COLUMNS, OUTPUT_COLUMNS
+from attitude_fmu.systems.simulation.motion import HumanMotion
+from attitude_fmu.systems.simulation.sensor_model import ImuModel
 
 FS = 100.0
 
@@ -313,7 +313,7 @@ def test_options_are_refused_before_any_input_is_read(tmp_path, capsys):
 
 
 def test_console_entry_point_reports_errors_without_traceback(tmp_path):
-    proc = subprocess.run([sys.executable, "-m", "systems.cli", "estimate", str(tmp_path / "none.csv"),
+    proc = subprocess.run([sys.executable, "-m", "attitude_fmu.systems.cli.commands", "estimate", str(tmp_path / "none.csv"),
                            "--out", str(tmp_path / "o.csv")], capture_output=True, text=True)
     assert proc.returncode == 2
     assert "no such file" in proc.stderr and "Traceback" not in proc.stderr

@@ -8,15 +8,15 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from blocks import tseng
-from blocks.methods import METHODS, estimator_system, stepper
-from blocks.sensor_frame import start_gravity
-from systems.batch import estimate
-from systems.cli import main
-from systems.compare import IMU, compare_profile
-from systems.errors import inclination_error, quaternion_errors, rms
-from systems.motion import PROFILES, profile
-from systems.sensor_model import ImuModel
+from attitude_fmu.blocks.errors import inclination_error, quaternion_errors, rms
+from attitude_fmu.blocks.filters import tseng
+from attitude_fmu.blocks.filters.sensor_frame import start_gravity
+from attitude_fmu.blocks.methods.registry import METHODS, estimator_system, stepper
+from attitude_fmu.blocks.pipeline.batch import estimate
+from attitude_fmu.systems.cli.commands import main
+from attitude_fmu.systems.evaluation.compare import IMU, compare_profile
+from attitude_fmu.systems.simulation.motion import PROFILES, profile
+from attitude_fmu.systems.simulation.sensor_model import ImuModel
 
 FS = 100.0
 HZ = np.logspace(-2, 1, 400)  # 0.01 … 10 Hz
@@ -31,8 +31,47 @@ def test_block_and_batch_path_run_the_same_step_for_every_method(name):
     resp = control.input_output_response(estimator_system(name, dt=1 / FS), np.arange(300) / FS,
                                          np.hstack([gyr, acc]).T,
                                          X0=step.initial_state(start_gravity(gyr[0], acc[0], 1 / FS)))
-    batch = estimate(gyr, acc, FS, name)
+    batch = estimate(gyr, acc, FS, name, gyro_offset=False)
     assert np.abs(resp.outputs.T - np.hstack([batch.gravity, batch.quat])).max() <= 1e-12
+
+
+@pytest.mark.parametrize("name", sorted(METHODS))
+def test_block_from_python_controls_default_initial_state_starts_on_its_first_sample(name):
+    """No X0: python-control starts every state at 0, a state no step can be in; the block
+    starts at rest on its first sample, as the batch path does, and the outputs are finite
+    and the batch path's from the first sample on."""
+    rng = np.random.default_rng(7)
+    gyr = rng.normal(0, 1.0, (200, 3))
+    acc = rng.normal(0, 1.0, (200, 3)) + [0.5, -2.0, 9.6]
+    resp = control.input_output_response(estimator_system(name, dt=1 / FS), np.arange(200) / FS,
+                                         np.hstack([gyr, acc]).T)
+    assert np.isfinite(resp.outputs).all()
+    batch = estimate(gyr, acc, FS, name, gyro_offset=False)
+    assert np.abs(resp.outputs.T - np.hstack([batch.gravity, batch.quat])).max() <= 1e-12
+
+
+@pytest.mark.parametrize("name", sorted(METHODS))
+def test_block_runs_its_kernel_once_per_step(name, monkeypatch):
+    """python-control asks a discrete system for its output and its next state in two calls
+    per step; the method's compiled step runs once for both."""
+    from attitude_fmu.blocks.filters.sensor_frame import SensorFrameStepper
+    from attitude_fmu.blocks.methods.registry import KernelStepper
+
+    runs = []
+    for cls in (SensorFrameStepper, KernelStepper):
+        original = cls.run
+        monkeypatch.setattr(cls, "run", lambda self, *a, _run=original: (runs.append(1), _run(self, *a))[1])
+    rng = np.random.default_rng(8)
+    n = 150
+    signals = np.hstack([rng.normal(0, 1.0, (n, 3)), rng.normal(0, 1.0, (n, 3)) + [0, 0, 9.81]]).T
+    control.input_output_response(estimator_system(name, {}, 1 / FS, name="under_test"), np.arange(n) / FS, signals)
+    assert len(runs) == n
+
+
+def test_block_takes_the_python_control_argument_names():
+    block = estimator_system(method="mahony", params={"k_P": 2.0}, dt=0.02, name="imu_filter")
+    assert block.name == "imu_filter" and block.dt == 0.02
+    assert block.input_labels == [f"{s}_{a}" for s in ("gyr", "acc") for a in "xyz"]
 
 
 def _gyro_integration(gyr, q0):
@@ -57,7 +96,7 @@ def test_luinge_fig5_on_coning():
     for offset in (0.0, 1.0):
         imu = ImuModel(delta_n=delta_n, acc_offset=tuple(np.full(3, offset / math.sqrt(3))))
         gyr, acc = imu.apply(motion, seed=5)
-        filt = quaternion_errors(estimate(gyr, acc, FS, "luinge", {"delta_n": delta_n}).quat, motion.quat)
+        filt = quaternion_errors(estimate(gyr, acc, FS, "luinge", {"delta_n": delta_n}, gyro_offset=False).quat, motion.quat)
         integ = quaternion_errors(_gyro_integration(gyr, q0), motion.quat)
         results[offset] = (filt, integ)
         # after the first seconds the filter's error stays below the gyro integration's
@@ -101,7 +140,7 @@ def test_tseng4_mounting_at_90_deg():
             motion = profile("linear_motion").motion({f"mount_{axis}_deg": mount}).generate(120.0, FS)
             gyr, acc = IMU.apply(motion, 1)
             kept = slice(2000, None)
-            errors[axis, mount] = {m: rms(np.degrees(inclination_error(estimate(gyr, acc, FS, m).up[kept],
+            errors[axis, mount] = {m: rms(np.degrees(inclination_error(estimate(gyr, acc, FS, m, gyro_offset=False).up[kept],
                                                                        motion.up[kept]))) for m in METHODS}
             roll, _ = tseng.euler_complementary(gyr, acc, FS)
             with warnings.catch_warnings():
@@ -187,7 +226,7 @@ def test_wiener_is_vqf_core_at_the_matching_break_frequency(offline):
         return rms(np.degrees(quaternion_errors(q[settled], q_ref[settled])[2]))
 
     def rms_difference(omega_g):
-        return rms_inclination(estimate(gyr, acc, FS, "wiener", {"omega_g": omega_g}, offline=offline).quat, q_vqf)
+        return rms_inclination(estimate(gyr, acc, FS, "wiener", {"omega_g": omega_g}, offline=offline, gyro_offset=False).quat, q_vqf)
 
     truth_error = rms_inclination(q_vqf, motion.quat)
     assert truth_error > 0.4  # vigorous motion: both are far from the truth ...

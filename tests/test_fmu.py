@@ -11,21 +11,30 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from fmpy import read_model_description
 from fmpy.fmi1 import FMICallException
 from fmpy.ssp.simulation import simulate_ssp
 from fmpy.validation import validate_fmu
 from scipy.spatial.transform import Rotation
 
-from blocks.methods import METHODS
-from blocks.online import STEP_TOLERANCE, OnlineEstimator
-from systems.batch import estimate
-from systems.cosim import FmuRunner, cosimulate, cosimulate_libcosim
-from systems.errors import inclination_error, rms
-from systems.fmu_build import (FINGERPRINT, FMU_NAMES, build, built_from, ensure_built, python_environment,
-                               source_fingerprint)
-from systems.motion import HumanMotion, profile
-from systems.sensor_model import ImuModel
-from systems.ssp import write_ssp
+from attitude_fmu.blocks.errors import inclination_error, rms
+from attitude_fmu.blocks.methods.registry import METHODS
+from attitude_fmu.blocks.pipeline.batch import estimate
+from attitude_fmu.blocks.pipeline.online import OnlineEstimator
+from attitude_fmu.blocks.stages.timing import STEP_TOLERANCE
+from attitude_fmu.systems.fmi.build import (
+    FINGERPRINT,
+    FMU_NAMES,
+    build_fmus,
+    built_from,
+    ensure_built,
+    python_environment,
+    source_fingerprint,
+)
+from attitude_fmu.systems.fmi.cosim import FmuRunner, cosimulate, cosimulate_libcosim
+from attitude_fmu.systems.fmi.ssp import write_ssp
+from attitude_fmu.systems.simulation.motion import HumanMotion, profile
+from attitude_fmu.systems.simulation.sensor_model import ImuModel
 from tests.test_real_data import _turns_with_field
 
 INPUTS = [f"{s}_{a}" for s in ("gyr", "acc") for a in "xyz"]
@@ -36,7 +45,7 @@ FS = 100.0
 @pytest.fixture(scope="module")
 def fmu_dir(tmp_path_factory):
     out = tmp_path_factory.mktemp("fmus")
-    build(out)
+    build_fmus(out)
     return out
 
 
@@ -83,6 +92,58 @@ def test_every_fmu_validates(fmu_dir):
         assert validate_fmu(str(fmu_dir / f"{name}.fmu")) == [], name
 
 
+def test_parameters_start_at_their_defaults_and_an_importer_may_set_every_start_value(fmu_dir, recording):
+    """Each tuning parameter's start value is the default it runs with (NaN, unset, where the
+    default is derived, or differs between methods); an importer that sets every parameter
+    to its start value (as some do) runs the defaults, also for a method that lacks most."""
+    from attitude_fmu.blocks.pipeline.causal import ESTIMATORS
+
+    md = read_model_description(str(fmu_dir / "AttitudeEstimator.fmu"))
+    start = {v.name: float(v.start) for v in md.modelVariables if v.causality == "parameter" and v.type == "Real"}
+    for stage in (*(m.params for m in METHODS.values()), *ESTIMATORS.values()):
+        for p in stage:
+            shared = {q.default for s in (*(m.params for m in METHODS.values()), *ESTIMATORS.values())
+                      for q in s if q.name == p.name}
+            expected = p.default if len(shared) == 1 and p.default is not None else math.nan
+            assert start[p.name] == expected or math.isnan(start[p.name]) and math.isnan(expected), p.name
+    assert start["delta_n"] == math.radians(0.1) and start["k_I"] == 0.3 and start["tau_heading"] == 10.0
+    assert math.isnan(start["omega_c"]) and math.isnan(start["mag_delay"])
+    gyr, acc = recording
+    for method in ("wiener", "mahony"):
+        every = {name: value for name, value in start.items() if name not in ("Ts", "latency")}
+        runner = FmuRunner(fmu_dir / "AttitudeEstimator.fmu", {"method": method, "gyro_offset": "off", **every},
+                           INPUTS, OUTPUTS)
+        out, _ = runner.run(np.hstack([gyr, acc]), 1 / FS)
+        runner.close()
+        assert np.abs(out[:, :4] - estimate(gyr, acc, FS, method, gyro_offset=False).quat).max() < 1e-9
+
+
+@pytest.mark.parametrize("name", FMU_NAMES)
+def test_each_fmu_carries_exactly_the_modules_its_adapter_imports(fmu_dir, tmp_path, name):
+    """The zip's Python files under resources/attitude_fmu are the modules a fresh
+    interpreter loads when it imports the FMU's adapter from there alone (the installed
+    attitude_fmu out of reach): no command line, plots, benchmarks or build code."""
+    with zipfile.ZipFile(fmu_dir / f"{name}.fmu") as zf:
+        carried = sorted(n.removeprefix("resources/") for n in zf.namelist()
+                         if n.startswith("resources/attitude_fmu/") and n.endswith(".py"))
+        zf.extractall(tmp_path)
+    script = textwrap.dedent(f"""
+        import importlib.machinery, importlib.util, json, sys
+        resources = {str(tmp_path / "resources")!r}
+        spec = importlib.machinery.ModuleSpec("attitude_fmu", None, is_package=True)
+        spec.submodule_search_locations = [resources + "/attitude_fmu"]  # this FMU's copy only
+        sys.modules["attitude_fmu"] = importlib.util.module_from_spec(spec)
+        sys.path.insert(0, resources)
+        import {name}
+        print(json.dumps(sorted(m.__file__[len(resources) + 1:] for m in list(sys.modules.values())
+                                if (getattr(m, "__file__", None) or "").startswith(resources + "/attitude_fmu/"))))
+    """)
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    assert json.loads(proc.stdout) == carried
+    assert not [f for f in carried if f.split("/")[1] == "systems" and f.split("/")[2] != "simulation"]
+
+
 @pytest.mark.parametrize("latency, gyr_samples, acc_samples", [(0.0, "mean", "point"), (0.004, "point", "mean")])
 @pytest.mark.parametrize("method", sorted(METHODS))
 def test_estimator_fmu_equals_the_batch_path(fmu_dir, recording, method, latency, gyr_samples, acc_samples):
@@ -92,7 +153,7 @@ def test_estimator_fmu_equals_the_batch_path(fmu_dir, recording, method, latency
                         **params)
     out, valid = runner.run(np.hstack([gyr, acc]), 1 / FS)
     runner.close()
-    ref = estimate(gyr, acc, FS, method, params, latency=latency, gyr_samples=gyr_samples, acc_samples=acc_samples)
+    ref = estimate(gyr, acc, FS, method, params, latency=latency, gyr_samples=gyr_samples, acc_samples=acc_samples, gyro_offset=False)
     assert valid.all()
     assert np.abs(out[:, :4] - ref.quat).max() < 1e-9
     assert np.abs(out[:, 4:] - ref.up).max() < 1e-9
@@ -100,7 +161,7 @@ def test_estimator_fmu_equals_the_batch_path(fmu_dir, recording, method, latency
 
 def test_estimator_fmu_heading_from_its_magnetometer_inputs_equals_the_batch_path(fmu_dir):
     """A magnetometer 20 ms behind the gyro at a third of the rate: the FMU is the batch
-    path, the online estimate of the delay (blocks.mag_delay) included, which takes
+    path, the online estimate of the delay (blocks.stages.mag_delay) included, which takes
     20.2 ms 5.2 s in."""
     motion = profile("sine_rotation").motion({"inclination_deg": 20.0}).generate(20.0, FS)
     gyr, acc = ImuModel(delta_n=math.radians(0.05), gyr_offset=(0.0, 0.0, 0.01)).apply(motion, seed=3)
@@ -110,20 +171,20 @@ def test_estimator_fmu_heading_from_its_magnetometer_inputs_equals_the_batch_pat
                        INPUTS + ["mag_x", "mag_y", "mag_z"], OUTPUTS + ["mag_delay_used"])
     out, _ = runner.run(np.hstack([gyr, acc, mag]), 1 / FS)
     runner.close()
-    ref = estimate(gyr, acc, FS, mag=mag)
+    ref = estimate(gyr, acc, FS, mag=mag, gyro_offset=False)
     assert ref.mag_delay_source == "online" and abs(ref.mag_delay[-1] - 0.02) < 1e-3
     assert np.abs(out[:, :4] - ref.quat).max() < 1e-9
     assert np.abs(out[:, 7] - ref.mag_delay).max() < 1e-12
-    assert np.abs(out[:, :4] - estimate(gyr, acc, FS, mag=mag, params={"mag_delay": 0.0}).quat).max() > 1e-4
+    assert np.abs(out[:, :4] - estimate(gyr, acc, FS, mag=mag, params={"mag_delay": 0.0}, gyro_offset=False).quat).max() > 1e-4
     assert not ref.mag_accepted[1::3].any() and ref.mag_accepted[::3].mean() > 0.9
     # the samples without a field keep the heading correction: the output stays smooth
     print("largest step of the output quaternion", np.abs(np.diff(out[:, :4], axis=0)).max())
     assert np.abs(np.diff(out[:, :4], axis=0)).max() < 0.01
-    assert np.abs(out[:, :4] - estimate(gyr, acc, FS).quat).max() > 1e-3  # the field was used
+    assert np.abs(out[:, :4] - estimate(gyr, acc, FS, gyro_offset=False).quat).max() > 1e-3  # the field was used
 
 
 def test_estimator_fmu_reports_the_hard_iron_estimate_of_the_batch_path(fmu_dir):
-    """150 s of turning with 18 µT of hard iron on the magnetometer (blocks.hard_iron takes
+    """150 s of turning with 18 µT of hard iron on the magnetometer (blocks.stages.hard_iron takes
     it at 75 s): the FMU's mag_offset outputs are the batch path's estimate."""
     motion, gyr, acc, mag = _turns_with_field()
     n = int(150 * FS)
@@ -132,14 +193,14 @@ def test_estimator_fmu_reports_the_hard_iron_estimate_of_the_batch_path(fmu_dir)
                        OUTPUTS + ["mag_offset_x", "mag_offset_y", "mag_offset_z"])
     out, _ = runner.run(np.hstack([gyr, acc, mag]), 1 / FS)
     runner.close()
-    ref = estimate(gyr, acc, FS, mag=mag)
+    ref = estimate(gyr, acc, FS, mag=mag, gyro_offset=False)
     assert np.abs(out[:, :4] - ref.quat).max() < 1e-9
     assert np.abs(out[:, 7:10] - ref.mag_offset).max() < 1e-9
     assert np.abs(out[-1, 7:10] - [15.0, -5.0, 8.0]).max() < 0.5
 
 
 def test_estimator_fmu_with_gyro_offset_on_equals_the_batch_path(fmu_dir):
-    """gyro_offset = "on": blocks.gyro_offset per step, as the batch path's gyro_offset=True;
+    """gyro_offset = "on": blocks.stages.gyro_offset per step, as the batch path's gyro_offset=True;
     with an ImuSensor-style offset of 1 °/s it removes the 3° error the filter has without."""
     motion = HumanMotion(delta_v=0.25).generate(120.0, FS, seed=3)
     offset = np.radians([1.0, -1.0, 0.5])
@@ -154,7 +215,7 @@ def test_estimator_fmu_with_gyro_offset_on_equals_the_batch_path(fmu_dir):
     assert np.abs(out[:, 7:10] - ref.offset).max() < 1e-12  # the estimate itself, an output
     last = slice(int(60 * FS), None)
     with_offset = np.degrees(inclination_error(out[last, 4:7], motion.up[last])).max()
-    without = np.degrees(inclination_error(estimate(gyr, acc, FS).up[last], motion.up[last])).max()
+    without = np.degrees(inclination_error(estimate(gyr, acc, FS, gyro_offset=False).up[last], motion.up[last])).max()
     print(f"max inclination error after 60 s: gyro_offset on {with_offset:.2f}°, off {without:.2f}°")
     assert with_offset < 1.0 < 2.0 < without
 
@@ -260,8 +321,8 @@ def test_instances_in_one_process_stay_independent(fmu_dir, recording):
         a.step(data[k], 1 / FS)  # a keeps stepping in between
     a.close()
     b.close()
-    assert np.abs(out_a[:, :4] - estimate(gyr[:300], acc[:300], FS).quat).max() < 1e-9
-    ref_b = estimate(other[:, :3], other[:, 3:], FS, params={"delta_v": 3.0})
+    assert np.abs(out_a[:, :4] - estimate(gyr[:300], acc[:300], FS, gyro_offset=False).quat).max() < 1e-9
+    ref_b = estimate(other[:, :3], other[:, 3:], FS, params={"delta_v": 3.0}, gyro_offset=False)
     assert np.abs(out_b[:, :4] - ref_b.quat).max() < 1e-9
 
 
@@ -273,12 +334,12 @@ def test_changed_step_size_is_rediscretised_and_logged(fmu_dir, recording, capsy
     runner.close()
     assert capsys.readouterr().out.count("differs from Ts") == 1
     # the same as the batch path over both halves, each at its own rate, carried across
-    first = estimate(gyr[:100], acc[:100], 100.0)
-    online = OnlineEstimator()
+    first = estimate(gyr[:100], acc[:100], 100.0, gyro_offset=False)
+    online = OnlineEstimator(gyro_offset=False)
     expected = []
     for k, row in enumerate(data):
         online.step(row[:3], row[3:], 0.01 if k < 100 else 0.02)
-        expected.append(online.io[6:10].copy())
+        expected.append(online.quat)
     assert np.abs(out[:100, :4] - first.quat).max() < 1e-9
     assert np.abs(out[:, :4] - np.array(expected)).max() < 1e-9
     # a master with a variable step: re-discretised for each step, one warning in all
@@ -314,8 +375,8 @@ def test_estimator_fmu_takes_a_zero_where_zero_is_a_setting(fmu_dir, recording, 
     runner = _estimator(fmu_dir, method=method, **{name: 0.0})
     out, _ = runner.run(np.hstack([gyr, acc]), 1 / FS)
     runner.close()
-    assert np.abs(out[:, :4] - estimate(gyr, acc, FS, method, {name: 0.0}).quat).max() < 1e-9
-    assert np.abs(out[:, :4] - estimate(gyr, acc, FS, method).quat).max() > 1e-6
+    assert np.abs(out[:, :4] - estimate(gyr, acc, FS, method, {name: 0.0}, gyro_offset=False).quat).max() < 1e-9
+    assert np.abs(out[:, :4] - estimate(gyr, acc, FS, method, gyro_offset=False).quat).max() > 1e-6
 
 
 @pytest.mark.parametrize("parameters, message", [
@@ -349,7 +410,7 @@ def test_an_fmu_of_other_code_than_the_process_has_loaded_ends_initialisation_in
     with zipfile.ZipFile(fmu_dir / "AttitudeEstimator.fmu") as src, zipfile.ZipFile(other, "w") as dst:
         for item in src.infolist():
             data = src.read(item)
-            dst.writestr(item, data + b"# another build\n" if item.filename == "resources/blocks/online.py" else data)
+            dst.writestr(item, data + b"# another build\n" if item.filename == "resources/attitude_fmu/blocks/pipeline/online.py" else data)
     with pytest.raises(FMICallException) as info:
         FmuRunner(other, {}, INPUTS, OUTPUTS, logging=False)
     assert info.value.status == 3  # fmi2Error
@@ -402,7 +463,7 @@ def test_fmi_status_follows_the_log_and_reset_clears_an_error(fmu_dir, recording
     gyr, acc = recording
     out, valid = runner.run(np.hstack([gyr, acc])[:100], 1 / FS)
     runner.close()
-    assert valid.all() and np.abs(out[:, :4] - estimate(gyr[:100], acc[:100], FS).quat).max() < 1e-9
+    assert valid.all() and np.abs(out[:, :4] - estimate(gyr[:100], acc[:100], FS, gyro_offset=False).quat).max() < 1e-9
     assert "non-finite input" in capsys.readouterr().out
 
 
@@ -419,7 +480,7 @@ def test_non_finite_inputs_hold_the_estimate_and_clear_valid(fmu_dir, recording,
     assert np.array_equal(out[20], out[19]) and np.array_equal(out[21], out[19])
     # the held samples are skipped: afterwards the estimate goes on from sample 19's state
     kept = np.delete(data, [20, 21], axis=0)
-    ref = estimate(kept[:, :3], kept[:, 3:], FS)
+    ref = estimate(kept[:, :3], kept[:, 3:], FS, gyro_offset=False)
     assert np.abs(out[22:, :4] - ref.quat[20:]).max() < 1e-9
 
 
@@ -527,7 +588,7 @@ def test_fmu_runs_in_a_fresh_environment_without_the_project(fmu_dir, recording,
         from fmpy import extract, read_model_description
         from fmpy.fmi2 import FMU2Slave
         try:
-            import blocks
+            import attitude_fmu.blocks
             sys.exit("the project is importable here")
         except ImportError:
             pass
@@ -546,7 +607,7 @@ def test_fmu_runs_in_a_fresh_environment_without_the_project(fmu_dir, recording,
         fmu.freeInstance()
         print(json.dumps(rows), flush=True)
         import os
-        os._exit(0)  # as systems.cosim: pythonfmu's library destructor may crash at shutdown
+        os._exit(0)  # as systems.fmi.cosim: pythonfmu's library destructor may crash at shutdown
     """)
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV")}
     proc = subprocess.run([str(python), "-c", script], capture_output=True, text=True, cwd=tmp_path, env=env)
@@ -562,7 +623,7 @@ def test_fmu_runs_in_an_importer_without_python(fmu_dir, tmp_path):
     pythonfmu's library cannot load (undefined Python symbols). The FMU's binary loads the
     libpython it was built with and starts the interpreter with the build environment's
     packages (fmu_build.python_environment); a C importer (tests/fmi_host.c) then gets the
-    estimate blocks.online computes from the same inputs."""
+    estimate blocks.pipeline.online computes from the same inputs."""
     from fmpy import extract, read_model_description
 
     cc = os.environ.get("CC") or "cc"
@@ -587,12 +648,12 @@ def test_fmu_runs_in_an_importer_without_python(fmu_dir, tmp_path):
     online = OnlineEstimator(gyro_offset=True)  # the FMU's default
     for _ in range(300):
         online.step(u[:3], u[3:], 1 / FS)
-    assert np.abs(np.array(proc.stdout.split(), dtype=float) - online.io[6:13]).max() < 1e-9
+    assert np.abs(np.array(proc.stdout.split(), dtype=float) - np.r_[online.quat, online.up]).max() < 1e-9
 
 
 def test_verify_cli_json_contract_and_exit_status(fmu_dir, monkeypatch, capsys):
-    from systems import verify as verify_module
-    from systems.cli import main
+    from attitude_fmu.systems.cli.commands import main
+    from attitude_fmu.systems.fmi import verify as verify_module
 
     # a short run of one scenario: the full table is the main job (`attitude verify`)
     monkeypatch.setitem(verify_module.SCENARIOS, "incline", verify_module.Scenario(240.0, "mean"))
@@ -612,7 +673,7 @@ def test_verify_cli_json_contract_and_exit_status(fmu_dir, monkeypatch, capsys):
 
 
 def test_without_a_c_compiler_the_build_warns_and_keeps_pythonfmus_binary(tmp_path, monkeypatch):
-    from systems.fmu_build import compile_guard
+    from attitude_fmu.systems.fmi.build import compile_guard
 
     monkeypatch.setenv("CC", str(tmp_path / "no-such-cc"))
     said = []
@@ -625,8 +686,8 @@ def test_guard_reports_a_missing_pythonfmu_library_instead_of_crashing(fmu_dir, 
 
     from fmpy import extract, read_model_description
 
-    from systems.cosim import load_slave
-    from systems.fmu_build import PYTHONFMU_LIBRARY
+    from attitude_fmu.systems.fmi.build import PYTHONFMU_LIBRARY
+    from attitude_fmu.systems.fmi.cosim import load_slave
 
     broken = tmp_path / "AttitudeEstimator.fmu"
     with zipfile.ZipFile(fmu_dir / "AttitudeEstimator.fmu") as src, zipfile.ZipFile(broken, "w") as dst:
@@ -656,7 +717,7 @@ def test_libcosim_runs_the_ssp_diagram_and_its_estimator_computes_ours(fmu_dir, 
     loads the three FMUs with FMI Library and steps them with its own fixed-step master, in
     which each connection delays by one step and inputs begin at their start values. The
     motion it records is the batch path's, and the estimator's outputs are those of
-    blocks.online on the inputs libcosim handed it: its FMI calls, the SSP's parameters
+    blocks.pipeline.online on the inputs libcosim handed it: its FMI calls, the SSP's parameters
     (String and Real, not the defaults) and its step size (kept in integer nanoseconds)
     all came through."""
     ssp = write_ssp(tmp_path / "human.ssp", fmu_dir, {
@@ -674,9 +735,8 @@ def test_libcosim_runs_the_ssp_diagram_and_its_estimator_computes_ours(fmu_dir, 
     received = np.column_stack([out[f"estimator.{n}"] for n in inputs])
     expected, valid = [], []
     for row in received:
-        online.io[0:6], online.io[16:19] = row[:6], row[6:]
-        valid.append(online.step_io(1 / FS))
-        expected.append(online.io[6:13].copy())
+        valid.append(online.step(row[:3], row[3:6], 1 / FS, row[6:]))
+        expected.append(np.r_[online.quat, online.up])
     assert (out["estimator.valid"] == np.array(valid)).all() and out["estimator.valid"][2:].all()
     estimated = np.column_stack([out[f"estimator.{n}"] for n in OUTPUTS])
     assert np.abs(estimated - np.array(expected))[out["estimator.valid"]].max() < 1e-12
@@ -701,8 +761,8 @@ def test_a_second_run_after_the_importer_deleted_the_first_fmus_folders(fmu_dir,
             print(run, ex.step(int({FS})), flush=True)
             del ex
         print("project code loaded from a folder that still exists:",
-              Path(sys.modules["blocks"].__file__).exists(), flush=True)
-        os._exit(0)  # as systems.cosim: pythonfmu's library destructor may crash at shutdown
+              Path(sys.modules["attitude_fmu.blocks.pipeline.online"].__file__).exists(), flush=True)
+        os._exit(0)  # as systems.fmi.cosim: pythonfmu's library destructor may crash at shutdown
     """)
     proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=tmp_path)
     assert proc.returncode == 0, proc.stdout + proc.stderr[-2000:]
@@ -715,8 +775,8 @@ def test_libcosim_and_our_master_hold_the_human_row_of_verify_to_its_bound(fmu_d
     one per connection) is within verify's bound (1.3 × eq. 41) under each, and the two
     agree within 2 %."""
     pytest.importorskip("libcosimpy")
-    from systems.experiments import settle_time
-    from systems.verify import SCENARIOS, STEP_S
+    from attitude_fmu.blocks.filters.earth_filters import settle_time
+    from attitude_fmu.systems.fmi.verify import SCENARIOS, STEP_S
 
     scenario = SCENARIOS["human"]
     ssp = write_ssp(tmp_path / "human.ssp", fmu_dir, {

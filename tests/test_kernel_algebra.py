@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from blocks.gyro_offset import CLIP_SIGMAS, OBSERVED, motion_update, scalar_update
-from blocks.hard_iron import STATE_SIZE, SUMS, _accumulate, _fit, _spread
+from attitude_fmu.blocks.stages.gyro_offset import CLIP_SIGMAS, OBSERVED, motion_update, scalar_update
+from attitude_fmu.blocks.stages.hard_iron import STATE_SIZE, SUMS, _accumulate, _fit, _spread
 
 
 def _joint_motion_update(b, P, old, new, r_lp, rb_lp, Ts, W, clip):

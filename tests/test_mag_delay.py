@@ -1,17 +1,17 @@
-"""A magnetometer that trails the gyro: its delay estimated online (blocks.mag_delay) or
-measured from a whole recording (systems.delays.mag_delay), and allowed for by the
-heading stage (blocks.heading)."""
+"""A magnetometer that trails the gyro: its delay estimated online (blocks.stages.mag_delay) or
+measured from a whole recording (blocks.stages.delays.mag_delay), and allowed for by the
+heading stage (blocks.stages.heading)."""
 import math
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from blocks.mag_delay import MAG_DELAY_MIN_S
-from systems.batch import estimate
-from systems.delays import mag_delay
-from systems.errors import quaternion_errors
-from systems.motion import ClosedFormMotion
-from systems.sensor_model import ImuModel
+from attitude_fmu.blocks.errors import quaternion_errors
+from attitude_fmu.blocks.pipeline.batch import estimate
+from attitude_fmu.blocks.stages.delays import mag_delay
+from attitude_fmu.blocks.stages.mag_delay import MAG_DELAY_MIN_S
+from attitude_fmu.systems.simulation.motion import ClosedFormMotion
+from attitude_fmu.systems.simulation.sensor_model import ImuModel
 
 FS = 200.0
 DELAY_STEPS = 6  # 30 ms at FS
@@ -60,12 +60,12 @@ def test_the_delay_is_measured_from_the_imu_alone():
 
 def test_the_heading_estimates_the_delay_online_or_takes_it_measured_or_given():
     """Online (the default) the heading stage estimates the delay as it goes
-    (blocks.mag_delay); offline it is measured from the whole recording."""
+    (blocks.stages.mag_delay); offline it is measured from the whole recording."""
     motion, gyr, acc, on_time, late = _fast_turns(hard_iron=(0.0, 0.0, 0.0))  # no hard-iron fit to wait for
-    runs = {"online": estimate(gyr, acc, FS, mag=late),
-            "offline": estimate(gyr, acc, FS, mag=late, offline=True),
-            "ignored": estimate(gyr, acc, FS, mag=late, params={"mag_delay": 0.0}),
-            "on time": estimate(gyr, acc, FS, mag=on_time)}
+    runs = {"online": estimate(gyr, acc, FS, mag=late, gyro_offset=False),
+            "offline": estimate(gyr, acc, FS, mag=late, offline=True, gyro_offset=False),
+            "ignored": estimate(gyr, acc, FS, mag=late, params={"mag_delay": 0.0}, gyro_offset=False),
+            "on time": estimate(gyr, acc, FS, mag=on_time, gyro_offset=False)}
     assert {name: e.mag_delay_source for name, e in runs.items()} == {
         "online": "online", "offline": "measured", "ignored": "given", "on time": "online"}
     delays = {name: e.mag_delay for name, e in runs.items()}
@@ -90,7 +90,7 @@ def test_the_online_estimate_starts_afresh_once_a_hard_iron_offset_is_taken():
     """With 15 µT of hard iron, the delay estimated before the offset is proven is dropped
     with the samples it came from, and the estimate from the freed field is the delay."""
     motion, gyr, acc, _, late = _fast_turns()
-    est = estimate(gyr, acc, FS, mag=late)
+    est = estimate(gyr, acc, FS, mag=late, gyro_offset=False)
     taken = int(np.argmax(np.abs(est.mag_offset).sum(axis=1) > 0))
     print(f"offset taken at {taken / FS:.1f} s, delay then {1e3 * est.mag_delay[taken - 1]:.2f} ms, "
           f"at the end {1e3 * est.mag_delay[-1]:.2f} ms")
@@ -111,8 +111,8 @@ def test_the_online_estimate_holds_for_a_slow_magnetometer_a_long_delay_and_one_
              "20 ms ahead": (-4, 3, 0.5)}
     for name, (steps, every, noise) in cases.items():
         mag = _field(motion.mag, steps, every, (0.0, 0.0, 0.0), noise)
-        online = estimate(gyr, acc, FS, mag=mag)
-        given = estimate(gyr, acc, FS, mag=mag, params={"mag_delay": max(steps, 0) / FS})
+        online = estimate(gyr, acc, FS, mag=mag, gyro_offset=False)
+        given = estimate(gyr, acc, FS, mag=mag, params={"mag_delay": max(steps, 0) / FS}, gyro_offset=False)
         errors = _heading_rmse(online.quat, motion), _heading_rmse(given.quat, motion)
         print(f"{name}: {1e3 * online.mag_delay[-1]:.2f} ms, heading {errors[0]:.3f}° (told: {errors[1]:.3f}°)")
         assert abs(online.mag_delay[-1] - max(steps, 0) / FS) < 1e-3, name

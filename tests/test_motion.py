@@ -5,14 +5,21 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from blocks import gyro_offset
-from blocks.heading import with_magnetometer
-from blocks.timing import carry_forward_rows
-from systems.batch import estimate
-from systems.diagram import simulate_closed_loop
-from systems.errors import inclination_error
-from systems.motion import EARTH_FIELD_UT, PROFILES, HumanMotion, _human_run, incline_oscillation, steady_lever_arm
-from systems.sensor_model import ImuModel
+from attitude_fmu.blocks.errors import inclination_error
+from attitude_fmu.blocks.pipeline.batch import estimate
+from attitude_fmu.blocks.stages import gyro_offset
+from attitude_fmu.blocks.stages.heading import with_magnetometer
+from attitude_fmu.blocks.stages.timing import carry_forward_rows
+from attitude_fmu.systems.simulation.diagram import simulate_closed_loop
+from attitude_fmu.systems.simulation.motion import (
+    EARTH_FIELD_UT,
+    PROFILES,
+    HumanMotion,
+    _human_run,
+    incline_oscillation,
+    steady_lever_arm,
+)
+from attitude_fmu.systems.simulation.sensor_model import ImuModel
 
 
 def test_human_motion_truth_is_exact_and_has_the_eq14_velocity_spectrum():
@@ -76,12 +83,12 @@ def test_closed_loop_diagram_equals_the_batch_pipeline(method):
     motion = HumanMotion()
     imu = ImuModel(delta_n=math.radians(0.1), gyr_offset=(0.01, 0.0, -0.01), acc_noise=0.01)
     fs = 100.0
-    noise, resp = simulate_closed_loop(motion, imu, fs, duration=5.0, method=method, seed=3)
+    noise, resp = simulate_closed_loop(motion, imu, fs, duration=5.0, method=method, seed=3, gyro_offset=False)
     state = motion.initial_state()
     truth = np.empty((len(noise), 10))
     _human_run(state, np.ascontiguousarray(noise[:, :6]), motion.coefficients(fs), truth)
     gyr, acc = imu.measure(truth[:, 0:3], truth[:, 3:6], noise[:, 6:12], fs)
-    est = estimate(gyr, acc, fs, method, initial_gravity=[0, 0, motion.g])
+    est = estimate(gyr, acc, fs, method, initial_gravity=[0, 0, motion.g], gyro_offset=False)
     up = Rotation.from_quat(truth[:, 6:10], scalar_first=True).inv().apply([0, 0, 1])
     assert np.abs(resp.outputs[1:4].T - est.gravity).max() <= 1e-12
     assert np.abs(resp.outputs[4:8].T - est.quat).max() <= 1e-12
@@ -104,7 +111,7 @@ def test_closed_loop_diagram_with_offset_and_heading_blocks_equals_the_batch_ker
     imu = ImuModel(delta_n=math.radians(0.1), gyr_offset=(0.01, 0.0, -0.01), acc_noise=0.01, latency=latency,
                    **mag_errors)
     fs = 100.0
-    noise, resp = simulate_closed_loop(motion, imu, fs, duration=5.0, params=params, seed=3, offset=True, heading=True,
+    noise, resp = simulate_closed_loop(motion, imu, fs, duration=5.0, params=params, seed=3, heading=True,
                                        latency=latency)
     noise_density = {k: v for k, v in params.items() if k == "delta_n"}  # the filter's and the offset estimator's
     offset_params = {**noise_density, **{k: v for k, v in params.items() if k == "rest_time"}}
@@ -118,7 +125,7 @@ def test_closed_loop_diagram_with_offset_and_heading_blocks_equals_the_batch_ker
     offset, variance = np.empty_like(gyr), np.empty_like(gyr)
     gyro_offset.run(gyro_offset.initial_state(coef, np.zeros(3), np.array([0.0, 0.0, motion.g])), coef,
                     gyr, np.ascontiguousarray(acc), offset, variance)
-    est = estimate(gyr - offset, acc, fs, params=noise_density, initial_gravity=[0, 0, motion.g])
+    est = estimate(gyr - offset, acc, fs, params=noise_density, initial_gravity=[0, 0, motion.g], gyro_offset=False)
     mag = imu.measure_mag(Rotation.from_quat(truth[:, 6:10], scalar_first=True).inv().apply(EARTH_FIELD_UT),
                           noise[:, 12:15], fs)
     quat, _, mag_offset, _ = with_magnetometer(est.quat, mag, fs, heading_params)

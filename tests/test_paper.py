@@ -6,9 +6,9 @@ import pytest
 from scipy import integrate
 from scipy.optimize import curve_fit
 
-from blocks import accuracy as ac
-from blocks import earth_filters as ef
-from systems import experiments as ex
+from attitude_fmu.blocks.filters import accuracy as ac
+from attitude_fmu.blocks.filters import earth_filters as ef
+from attitude_fmu.systems.evaluation import experiments as ex
 
 
 def test_table1_first_row_simulated_within_7_percent_of_eq50():

@@ -3,8 +3,8 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from blocks.timing import carry_forward_rows
-from blocks.quaternion import level_quat, quat_multiply, quat_normalized, quat_rotate, rotvec_quat
+from attitude_fmu.blocks.quaternion import level_quat, quat_multiply, quat_normalized, quat_rotate, rotvec_quat
+from attitude_fmu.blocks.stages.timing import carry_forward_rows
 
 RNG = np.random.default_rng(7)
 
@@ -41,7 +41,7 @@ def test_level_quat_is_the_smallest_rotation_onto_up(u):
 
 
 def test_carry_forward_matches_scipy():
-    """blocks.timing: q ⊗ exp(ω·L) and the up-vector in the sensor frame L later."""
+    """blocks.stages.timing: q ⊗ exp(ω·L) and the up-vector in the sensor frame L later."""
     rot = Rotation.random(40, random_state=3)
     gyr, gravity, latency = RNG.normal(scale=3.0, size=(40, 3)), RNG.normal(scale=9.81, size=(40, 3)), 0.004
     quat, up = rot.as_quat(scalar_first=True), gravity.copy()
@@ -56,8 +56,8 @@ def test_carry_forward_matches_scipy():
 def test_integrated_rates_rebuild_a_closed_form_motion():
     """A closed-form coning motion's gyro (the rotation vector of each sample's interval)
     integrated from the identity gives its orientations relative to the first."""
-    from blocks.quaternion import integrate_rates
-    from systems.motion import coning
+    from attitude_fmu.blocks.quaternion import integrate_rates
+    from attitude_fmu.systems.simulation.motion import coning
 
     motion = coning().generate(60.0, 100.0)
     quat = np.empty_like(motion.quat)

@@ -12,22 +12,23 @@ from scipy import integrate
 from scipy.io import loadmat, savemat
 from scipy.spatial.transform import Rotation
 
-from blocks import accuracy as ac
-from blocks import earth_filters as ef
-from blocks.gyro_offset import coefficients as offset_coefficients
-from blocks.gyro_offset import correct as correct_gyro
-from blocks.gyro_offset import resolve as resolve_offset_params
-from blocks.heading import with_magnetometer
-from blocks.timing import interval_means
-from systems import experiments as ex
-from systems.batch import estimate
-from systems.cli import main
-from systems.errors import inclination_error, quaternion_errors, rms
-from systems.compare import peer_quaternions
-from systems.evaluate import evaluate_recording, imu_latency
-from systems.motion import EARTH_FIELD_UT, PROFILES, ClosedFormMotion, HumanMotion, Motion
-from systems.recording import Recording, read_recording
-from systems.sensor_model import ImuModel
+from attitude_fmu.blocks.errors import inclination_error, quaternion_errors, rms
+from attitude_fmu.blocks.filters import accuracy as ac
+from attitude_fmu.blocks.filters import earth_filters as ef
+from attitude_fmu.blocks.pipeline.batch import estimate
+from attitude_fmu.blocks.stages.gyro_offset import coefficients as offset_coefficients
+from attitude_fmu.blocks.stages.gyro_offset import correct as correct_gyro
+from attitude_fmu.blocks.stages.gyro_offset import resolve as resolve_offset_params
+from attitude_fmu.blocks.stages.heading import with_magnetometer
+from attitude_fmu.blocks.stages.timing import interval_means
+from attitude_fmu.systems.cli.commands import main
+from attitude_fmu.systems.evaluation import experiments as ex
+from attitude_fmu.systems.evaluation.compare import peer_quaternions
+from attitude_fmu.systems.evaluation.evaluate import evaluate_recording, imu_latency
+from attitude_fmu.systems.recordings.reading import read_recording
+from attitude_fmu.systems.recordings.recording import Recording
+from attitude_fmu.systems.simulation.motion import EARTH_FIELD_UT, PROFILES, ClosedFormMotion, HumanMotion, Motion
+from attitude_fmu.systems.simulation.sensor_model import ImuModel
 from tests.interpreted import interpreted_json
 
 FS = 100.0
@@ -55,7 +56,7 @@ def test_offline_needs_an_earth_frame_filter():
     rng = np.random.default_rng(0)
     gyr, acc = rng.normal(0, 0.1, (50, 3)), rng.normal(0, 0.1, (50, 3)) + [0, 0, 9.81]
     with pytest.raises(ValueError, match="offline smoothing needs"):
-        estimate(gyr, acc, FS, "mahony", offline=True)
+        estimate(gyr, acc, FS, "mahony", offline=True, gyro_offset=False)
 
 
 def _window(t, period=300.0, rest=60.0, ramp=2.0):
@@ -93,7 +94,7 @@ def test_gyro_offset_converges_and_attitude_stays_bounded_over_an_hour():
     # no drift: the last ten minutes are no worse than the first hour's quarter
     assert inclination[-60000:].max() < 2 * inclination[after_first_rest:int(900 * FS)].max() + 0.1
     # without the offset estimator the same recording is far off
-    without = np.degrees(inclination_error(estimate(gyr, acc, FS).gravity, motion.up))
+    without = np.degrees(inclination_error(estimate(gyr, acc, FS, gyro_offset=False).gravity, motion.up))
     print(f"max inclination error with the offset estimator {inclination[after_first_rest:].max():.2f}°, "
           f"without {without[after_first_rest:].max():.2f}°")
     assert without[after_first_rest:].max() > 4 * inclination[after_first_rest:].max()
@@ -157,7 +158,7 @@ def test_a_short_rest_gives_the_mean_of_its_gyro_samples():
 
 @pytest.mark.parametrize("size", [1.0, 3.0])  # °/s; vqf clips its estimate at 2 °/s
 def test_offset_is_tracked_while_moving_without_rest(size):
-    """No rest at all: the accelerometer in the gyro frame pins the offset down (blocks.gyro_offset)."""
+    """No rest at all: the accelerometer in the gyro frame pins the offset down (blocks.stages.gyro_offset)."""
     motion = HumanMotion(delta_v=0.25).generate(600.0, FS, seed=1)
     gyr, acc = ImuModel(delta_n=math.radians(0.02), acc_noise=0.002).apply(motion, seed=11)
     offset = np.radians([1.0, -1.0, 0.5]) * size
@@ -168,10 +169,10 @@ def test_offset_is_tracked_while_moving_without_rest(size):
     untracked, _ = correct_gyro(gyr + offset, acc, FS, {"tau_motion": 0.0})
     vqf_up = Rotation.from_quat(peer_quaternions("vqf", gyr + offset, acc, FS), scalar_first=True).inv().apply([0, 0, 1])
     print(f"offset {size} °/s, inclination RMS: tracked {error(est.up):.3f}°, "
-          f"without offset {error(estimate(gyr, acc, FS).up):.3f}°, "
-          f"rest-only estimator {error(estimate(untracked, acc, FS).up):.3f}°, vqf {error(vqf_up):.3f}°")
-    assert error(est.up) < 1.1 * error(estimate(gyr, acc, FS).up)
-    assert error(estimate(untracked, acc, FS).up) > 5 * error(est.up)
+          f"without offset {error(estimate(gyr, acc, FS, gyro_offset=False).up):.3f}°, "
+          f"rest-only estimator {error(estimate(untracked, acc, FS, gyro_offset=False).up):.3f}°, vqf {error(vqf_up):.3f}°")
+    assert error(est.up) < 1.1 * error(estimate(gyr, acc, FS, gyro_offset=False).up)
+    assert error(estimate(untracked, acc, FS, gyro_offset=False).up) > 5 * error(est.up)
     if size > 2.0:
         assert error(vqf_up) > 5 * error(est.up)
 
@@ -213,9 +214,9 @@ def test_offline_offset_comes_from_the_whole_recording():
     causal, _ = correct_gyro(gyr, acc, FS)
     error = lambda e: rms(np.degrees(inclination_error(e.up, up)))
     print(f"offline inclination RMS: offset from both passes {error(est):.3f}°, "
-          f"forward only {error(estimate(causal, acc, FS, offline=True)):.3f}°")
+          f"forward only {error(estimate(causal, acc, FS, offline=True, gyro_offset=False)):.3f}°")
     assert np.degrees(np.abs(est.offset - offset)).max() < 0.15  # °/s, from the first sample on
-    assert error(est) < 0.6 * error(estimate(causal, acc, FS, offline=True))
+    assert error(est) < 0.6 * error(estimate(causal, acc, FS, offline=True, gyro_offset=False))
 
 
 @pytest.mark.parametrize("profile", ["lever_arm", "offset_rotation"])
@@ -231,7 +232,7 @@ def test_offset_tracking_does_not_take_centripetal_acceleration_for_an_offset(pr
 
 
 def test_offset_estimator_compiled_equals_its_plain_python_source():
-    code = ("import json; from blocks.gyro_offset import correct; from tests.test_real_data import _offset_case;"
+    code = ("import json; from attitude_fmu.blocks.stages.gyro_offset import correct; from tests.test_real_data import _offset_case;"
             "print(json.dumps(correct(*_offset_case(), 100.0)[1].tolist()))")
     assert np.abs(np.array(interpreted_json(code)) - correct_gyro(*_offset_case(), FS)[1]).max() <= 1e-12
 
@@ -300,7 +301,7 @@ def _delayed_imu(motion, duration: float, delay: float):
 def test_latency_carries_a_delayed_imu_onto_the_motion(offline):
     """An IMU 8 ms (0.8 samples) behind a closed-form pitching motion: the estimate lags
     with it, its inclination error the rate times the delay (RMS of |ω|·d, within 5 %).
-    Carried forward over the delay (blocks.timing), what is left is the extrapolation's
+    Carried forward over the delay (blocks.stages.timing), what is left is the extrapolation's
     second-order term: the gyro's last sample is the rate (d + Ts)/2 before the middle of
     the delay, so |ω̇|·d·(d + Ts)/2 (within 10 %), under 3 % of the lag's error."""
     delay = 0.008
@@ -310,7 +311,7 @@ def test_latency_carries_a_delayed_imu_onto_the_motion(offline):
     settled = slice(int(20 * FS), None)
     errors = {}
     for latency in (0.0, delay):
-        est = estimate(gyr, acc, FS, offline=offline, latency=latency)
+        est = estimate(gyr, acc, FS, offline=offline, latency=latency, gyro_offset=False)
         errors[latency] = rms(inclination_error(est.up[settled], up[settled]))
         from_quat = Rotation.from_quat(est.quat[settled], scalar_first=True).inv().apply([0.0, 0.0, 1.0])
         assert np.abs(from_quat - est.up[settled]).max() < 1e-9  # q and the up-vector carried alike
@@ -504,7 +505,7 @@ def test_parameters_reach_every_running_stage_that_has_them():
     noise, offset_only, heading_only = {"delta_n": math.radians(0.3)}, {"rest_time": 3.0}, {"tau_heading": 5.0}
     est = estimate(gyr, acc, FS, params={**noise, **offset_only, **heading_only}, gyro_offset=True, mag=mag)
     corrected, offset = correct_gyro(gyr, acc, FS, {**noise, **offset_only})
-    quat = with_magnetometer(estimate(corrected, acc, FS, params=noise).quat, mag, FS, heading_only)[0]
+    quat = with_magnetometer(estimate(corrected, acc, FS, params=noise, gyro_offset=False).quat, mag, FS, heading_only)[0]
     assert np.array_equal(est.offset, offset) and np.array_equal(est.quat, quat)
     assert np.abs(est.quat - estimate(gyr, acc, FS, gyro_offset=True, mag=mag).quat).max() > 1e-4
     with pytest.raises(ValueError, match=r"unknown parameter 'tau_heading' \(the method wiener: delta_n.*; "
@@ -515,7 +516,7 @@ def test_parameters_reach_every_running_stage_that_has_them():
 def test_magnetometer_heading_follows_the_field_and_survives_a_disturbance():
     motion, gyr, acc, mag = _turns_with_field()
     heading_of = lambda est: np.degrees(quaternion_errors(est.quat, motion.quat)[1])
-    gyro_only, with_mag = estimate(gyr, acc, FS), estimate(gyr, acc, FS, mag=mag)
+    gyro_only, with_mag = estimate(gyr, acc, FS, gyro_offset=False), estimate(gyr, acc, FS, mag=mag, gyro_offset=False)
     assert heading_of(gyro_only)[-1] > 45.0  # the gyro's heading walks off
     assert np.sqrt(np.mean(heading_of(with_mag) ** 2)) < 3.0
     # inclination is not touched by the heading stage
@@ -564,7 +565,7 @@ def test_a_new_field_needs_the_sensor_to_turn():
     refused as well, until mag_new_angle asks for no turn."""
     motion, gyr, acc, mag = _turns_with_field()
     mag[20000:] += [30.0, 0.0, 0.0]
-    quat = estimate(gyr, acc, FS).quat
+    quat = estimate(gyr, acc, FS, gyro_offset=False).quat
     default, accepted, _, _ = with_magnetometer(quat, mag, FS, {"mag_cal_time": 0.0})
     never, _, _, _ = with_magnetometer(quat, mag, FS, {"mag_new_time": 1e9, "mag_cal_time": 0.0})
     assert np.array_equal(default, never) and accepted[20000:].mean() < 0.1
@@ -609,7 +610,7 @@ def test_a_magnet_carried_for_a_while_is_fitted_then_dropped():
     only fall back on the gyro, whose 0.2 °/s offset walks the heading off meanwhile."""
     motion, gyr, acc, mag = _turns_with_field()
     mag[20000:30000] += [30.0, 0.0, 0.0]
-    quat = estimate(gyr, acc, FS).quat  # 6D
+    quat = estimate(gyr, acc, FS, gyro_offset=False).quat  # 6D
     rms_heading = lambda out: rms(np.degrees(quaternion_errors(out, motion.quat)[1]))
     out, _, offset, _ = with_magnetometer(quat, mag, FS)
     used = np.abs(offset).sum(axis=1) > 0
@@ -625,7 +626,7 @@ def test_a_magnet_carried_for_a_while_is_fitted_then_dropped():
 def test_offline_each_hard_iron_offset_holds_from_where_the_field_began_to_fit_it():
     """The magnet of the test above, offline: the forward pass proves the offset only
     after mag_new_time of fitting, and drops it as late; offline each change is moved back
-    to where the field began to fit the new sphere (blocks.hard_iron.back_dated). So the
+    to where the field began to fit the new sphere (blocks.stages.hard_iron.back_dated). So the
     offset is in use from within 1 s of 200 s to within 1 s of 300 s, and the heading is
     better than the forward pass's on the same smoothed attitude."""
     motion, gyr, acc, mag = _turns_with_field()
@@ -690,7 +691,7 @@ def _hard_iron_case():
     18 µT of hard iron put on at rest at 15–20 s (the window starts afresh at 20 s, with
     no directions) and taken off at 130–135 s through up to 27 µT more (the window that
     holds it fits no sphere and starts afresh at 155 s), and every third field sample
-    missing: every branch of blocks.hard_iron (taken at 105 s, dropped at 231 s)."""
+    missing: every branch of blocks.stages.hard_iron (taken at 105 s, dropped at 231 s)."""
     motion, _, _, mag = _turns_with_field(rest=(0.0, 30.0), duration=240.0)
     t = np.arange(len(mag)) / FS
     on, off = np.clip((t - 15.0) / 5.0, 0.0, 1.0), np.clip((t - 130.0) / 5.0, 0.0, 1.0)
@@ -700,7 +701,7 @@ def _hard_iron_case():
 
 
 def test_heading_compiled_equals_its_plain_python_source():
-    code = ("import json; from blocks.heading import with_magnetometer; "
+    code = ("import json; from attitude_fmu.blocks.stages.heading import with_magnetometer; "
             "from tests.test_real_data import _hard_iron_case;"
             "out, _, offset, _ = with_magnetometer(*_hard_iron_case(), 100.0);"
             "print(json.dumps([out.tolist(), offset.tolist()]))")
@@ -718,7 +719,7 @@ def test_heading_compiled_equals_its_plain_python_source():
 def test_magnetometer_input_errors_say_what_is_wrong(bad, message):
     gyr, acc = np.zeros((50, 3)), np.tile([0.0, 0.0, 9.81], (50, 1))
     with pytest.raises(ValueError, match=message):
-        estimate(gyr, acc, FS, mag=bad(np.tile(EARTH_FIELD_UT, (50, 1)).astype(float)))
+        estimate(gyr, acc, FS, mag=bad(np.tile(EARTH_FIELD_UT, (50, 1)).astype(float)), gyro_offset=False)
 
 
 def test_heading_and_tilt_start_in_motion():
@@ -728,7 +729,7 @@ def test_heading_and_tilt_start_in_motion():
     motion = HumanMotion(delta_v=1.0).generate(200.0, FS, seed=1)
     gyr, acc = ImuModel(delta_n=math.radians(0.05), acc_noise=0.002).apply(motion, seed=6)
     start = int(30 * FS)  # cut into the motion
-    est = estimate(gyr[start:], acc[start:], FS, mag=motion.mag[start:])
+    est = estimate(gyr[start:], acc[start:], FS, mag=motion.mag[start:], gyro_offset=False)
     _, heading, inclination = (np.degrees(e) for e in quaternion_errors(est.quat, motion.quat[start:]))
     settled = int(30 * FS)
     assert inclination[0] > 20.0

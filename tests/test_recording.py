@@ -10,12 +10,13 @@ import pytest
 from scipy.io import savemat
 from scipy.spatial.transform import Rotation
 
-from systems.batch import estimate
-from systems.cli import main
-from systems.errors import inclination_error, rms
-from systems.motion import ClosedFormMotion, HumanMotion
-from systems.recording import IMU_COLUMNS, REF_COLUMNS, RecordingError, read_recording
-from systems.sensor_model import ImuModel
+from attitude_fmu.blocks.errors import inclination_error, rms
+from attitude_fmu.blocks.pipeline.batch import estimate
+from attitude_fmu.systems.cli.commands import main
+from attitude_fmu.systems.recordings.reading import read_recording
+from attitude_fmu.systems.recordings.recording import IMU_COLUMNS, REF_COLUMNS, RecordingError
+from attitude_fmu.systems.simulation.motion import ClosedFormMotion, HumanMotion
+from attitude_fmu.systems.simulation.sensor_model import ImuModel
 
 FS = 100.0
 
@@ -192,7 +193,12 @@ def test_a_sensor_held_at_its_range_is_noted(tmp_path):
     steady 3 rad/s (16-bit samples, which hold it exactly), throughout or after 40 s at rest."""
     from scipy.spatial.transform import Rotation
 
-    from systems.motion import ClosedFormMotion, offset_rotation, sine_rotation, steady_lever_arm
+    from attitude_fmu.systems.simulation.motion import (
+        ClosedFormMotion,
+        offset_rotation,
+        sine_rotation,
+        steady_lever_arm,
+    )
 
     lsb = math.radians(2000.0) / 32768
     quantized = lambda g, a: (np.round(g / lsb) * lsb, np.round(a / 1e-3) * 1e-3)

@@ -7,12 +7,12 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from blocks import earth_filters as ef
-from blocks.methods import method
-from blocks.sensor_frame import initial_state, sensor_frame_system, start_gravity
-from systems.batch import estimate
-from systems.errors import inclination_error
-from systems.motion import HumanMotion
+from attitude_fmu.blocks.errors import inclination_error
+from attitude_fmu.blocks.filters import earth_filters as ef
+from attitude_fmu.blocks.filters.sensor_frame import initial_state, sensor_frame_system, start_gravity
+from attitude_fmu.blocks.methods.registry import method
+from attitude_fmu.blocks.pipeline.batch import estimate
+from attitude_fmu.systems.simulation.motion import HumanMotion
 from tests.interpreted import interpreted_json
 
 FILTERS = {
@@ -53,7 +53,7 @@ def test_discrete_block_and_batch_path_are_equal(name):
     t = np.arange(len(gyr)) / fs
     x0 = initial_state(filt, 1 / fs, start_gravity(gyr[0], acc[0], 1 / fs))
     resp = control.input_output_response(block, t, np.hstack([gyr, acc]).T, X0=x0)
-    batch = estimate(gyr, acc, fs, name, {"stationary": 1} if name == "wiener" else None)  # the LTI filter
+    batch = estimate(gyr, acc, fs, name, {"stationary": 1} if name == "wiener" else None, gyro_offset=False)  # the LTI filter
     assert np.abs(resp.outputs[:3].T - batch.gravity).max() <= 1e-12
     assert np.abs(resp.outputs[3:].T - batch.quat).max() <= 1e-12
 
@@ -61,22 +61,22 @@ def test_discrete_block_and_batch_path_are_equal(name):
 def test_compiled_kernel_equals_its_plain_python_source():
     """The batch path run with numba's JIT disabled (the readable reference) gives the same numbers."""
     code = (
-        "import json, numpy as np; from systems.batch import estimate;"
+        "import json, numpy as np; from attitude_fmu.blocks.pipeline.batch import estimate;"
         "from tests.test_sensor_frame import _random_imu;"
-        "g, a = _random_imu(); e = estimate(g, a, 100.0);"
+        "g, a = _random_imu(); e = estimate(g, a, 100.0, gyro_offset=False);"
         "print(json.dumps([e.gravity.tolist(), e.quat.tolist()]))"
     )
     gravity, quat = (np.array(x) for x in interpreted_json(code))
-    compiled = estimate(*_random_imu(), 100.0)
+    compiled = estimate(*_random_imu(), 100.0, gyro_offset=False)
     assert np.abs(gravity - compiled.gravity).max() <= 1e-12
     assert np.abs(quat - compiled.quat).max() <= 1e-12
 
 
 def test_pure_rotation_without_acceleration_is_tracked_exactly():
-    """For an earth-fixed input and piecewise-constant rate the discrete step is exact (NOTES §2)."""
+    """For an earth-fixed input and piecewise-constant rate the discrete step is exact (docs/conventions.md, "Discrete steps")."""
     motion = HumanMotion(delta_v=1e-12, rot_rms=3.0, rot_cutoff=5.0).generate(120.0, 100.0, seed=4)
     # the default start (the first sample turned back by the first rotation) is exact
-    est = estimate(motion.gyr, motion.acc, 100.0)
+    est = estimate(motion.gyr, motion.acc, 100.0, gyro_offset=False)
     assert np.abs(est.gravity - 9.81 * motion.up).max() < 1e-9
     # the quaternion output carries the same inclination, and heading from the gyro alone
     assert inclination_error(Rotation.from_quat(est.quat, scalar_first=True).apply(est.up),
@@ -98,7 +98,7 @@ def _discrete_vs_continuous(fs, duration=20.0):
         solve_ivp_kwargs={"rtol": 1e-10, "atol": 1e-12, "max_step": 1 / fs},
     )
     # discrete sample k covers (t[k-1], t[k]]: start it on the continuous run's state at t[0]
-    disc = estimate(gyr[1:], acc[1:], fs, params={"omega_g": 0.5}, initial_gravity=acc[0])
+    disc = estimate(gyr[1:], acc[1:], fs, params={"omega_g": 0.5}, initial_gravity=acc[0], gyro_offset=False)
     return np.abs(cont.outputs.T[1:] - disc.gravity).max()
 
 
@@ -113,14 +113,14 @@ def test_discrete_step_converges_to_the_continuous_block_at_first_order():
 def test_bad_input_is_refused_with_a_clear_message():
     gyr, acc = _random_imu(10)
     with pytest.raises(ValueError, match="shape"):
-        estimate(gyr[:, :2], acc, 100.0)
+        estimate(gyr[:, :2], acc, 100.0, gyro_offset=False)
     with pytest.raises(ValueError, match="differ in length"):
-        estimate(gyr, acc[:5], 100.0)
+        estimate(gyr, acc[:5], 100.0, gyro_offset=False)
     bad = acc.copy()
     bad[4, 1] = np.nan
     with pytest.raises(ValueError, match="non-finite.*sample 4"):
-        estimate(gyr, bad, 100.0)
+        estimate(gyr, bad, 100.0, gyro_offset=False)
     with pytest.raises(ValueError, match="sample rate"):
-        estimate(gyr, acc, -5.0)
+        estimate(gyr, acc, -5.0, gyro_offset=False)
     with pytest.raises(ValueError, match="sample time"):
         sensor_frame_system(ef.butterworth(0.1), dt=math.inf)

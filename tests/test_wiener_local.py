@@ -1,5 +1,5 @@
 """The default `wiener`: eq. 34 with its break frequency from locally measured noise
-densities (blocks.wiener_local), against the stationary filter and eq. 46."""
+densities (blocks.methods.wiener_local), against the stationary filter and eq. 46."""
 import math
 
 import control
@@ -7,13 +7,14 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from blocks import accuracy, wiener_local
-from blocks.methods import method, stepper
-from systems.batch import _run_local, estimate
-from systems.compare import peer_quaternions
-from systems.errors import inclination_error, rms
-from systems.motion import HumanMotion
-from systems.sensor_model import ImuModel
+from attitude_fmu.blocks.errors import inclination_error, rms
+from attitude_fmu.blocks.filters import accuracy
+from attitude_fmu.blocks.methods import wiener_local
+from attitude_fmu.blocks.methods.registry import method, stepper
+from attitude_fmu.blocks.pipeline.batch import _run_local, estimate
+from attitude_fmu.systems.evaluation.compare import peer_quaternions
+from attitude_fmu.systems.simulation.motion import HumanMotion
+from attitude_fmu.systems.simulation.sensor_model import ImuModel
 
 DELTA_N = math.radians(0.1)  # rad/s/√Hz, the default
 FS = 100.0
@@ -56,7 +57,7 @@ def test_start_up_then_an_imposed_constant_break_frequency_is_the_stationary_fil
         frame = frame * Rotation.from_rotvec(gyr[k] / FS)  # sensor k → the frame of the start
         in_gyro_frame += frame.apply(acc[k])
         assert np.abs(gravity[k] - frame.inv().apply(in_gyro_frame / (k + 1))).max() < 1e-9
-    stationary = estimate(gyr[k0:], acc[k0:], FS, "wiener", {"omega_g": omega}, initial_gravity=gravity[k0 - 1])
+    stationary = estimate(gyr[k0:], acc[k0:], FS, "wiener", {"omega_g": omega}, initial_gravity=gravity[k0 - 1], gyro_offset=False)
     assert np.abs(gravity[k0:] - stationary.gravity).max() < 1e-9
 
 
@@ -68,8 +69,8 @@ def test_local_densities_reach_eq46_on_stationary_motion(delta_v):
     δv = 1 m/s/√Hz loses when the motion is gentler."""
     motion, gyr, acc = _human(delta_v)
     optimum = math.degrees(accuracy.rms_attitude_error(DELTA_N, delta_v, 1.0, 9.81))
-    local = _rms_deg(estimate(gyr, acc, FS, "wiener", {"scale_error": 0.0}), motion)
-    nominal = _rms_deg(estimate(gyr, acc, FS, "wiener", {"stationary": 1}), motion)
+    local = _rms_deg(estimate(gyr, acc, FS, "wiener", {"scale_error": 0.0}, gyro_offset=False), motion)
+    nominal = _rms_deg(estimate(gyr, acc, FS, "wiener", {"stationary": 1}, gyro_offset=False), motion)
     print(f"δv={delta_v}: eq. 46 {optimum:.3f}°, local {local:.3f}°, stationary nominal {nominal:.3f}°")
     assert abs(local / optimum - 1) < 0.05
     if delta_v != 1.0:
@@ -84,7 +85,7 @@ def test_local_filter_settles_where_its_noise_model_says():
     motion, gyr, acc = _human(1.0)  # rot_rms 1 rad/s per axis: ⟨|ω|²⟩ = 3 rad²/s²
     filt = wiener_local.settled_filter(method("wiener").resolve(), 3.0, 1.0)
     analytic = math.degrees(math.sqrt(2.0 * accuracy.mean_square_error(filt, DELTA_N, 1.0, 10.0, 9.81)) / 9.81)
-    local = _rms_deg(estimate(gyr, acc, FS, "wiener"), motion)
+    local = _rms_deg(estimate(gyr, acc, FS, "wiener", gyro_offset=False), motion)
     print(f"settled ω_g {-np.real(control.poles(filt))[0] * math.sqrt(2):.3f} rad/s: eq. 41 {analytic:.3f}°, "
           f"local {local:.3f}°")
     assert abs(local / analytic - 1) < 0.10
@@ -100,7 +101,7 @@ def test_scale_error_term_lowers_the_error_of_a_miscalibrated_gyro(offline):
     stop = len(acc) - SETTLE
 
     def error(params):
-        return _rms_deg(estimate(gyr, acc, FS, "wiener", params, offline=offline), motion, stop)
+        return _rms_deg(estimate(gyr, acc, FS, "wiener", params, offline=offline, gyro_offset=False), motion, stop)
 
     with_term, without, told = error({}), error({"scale_error": 0.0}), error({"delta_v": 0.25})
     print(f"scale error 0.5 %, offline={offline}: local {with_term:.3f}°, without the term {without:.3f}°, "
@@ -121,8 +122,8 @@ def test_with_a_real_gyro_the_defaults_meet_the_best_fixed_filter_and_beat_vqf(d
     gyr, acc = ImuModel(delta_n=DELTA_N, gyr_scale=scale, acc_noise=0.01).apply(motion, seed=4)
     kept = slice(int(100 * FS), None)
     error = lambda up: math.degrees(rms(inclination_error(up[kept], motion.up[kept])))
-    ours = error(estimate(gyr, acc, FS).up)
-    best = min(error(estimate(gyr, acc, FS, params={"omega_g": w}).up) for w in 0.05 * 2.0 ** np.arange(7))
+    ours = error(estimate(gyr, acc, FS, gyro_offset=False).up)
+    best = min(error(estimate(gyr, acc, FS, params={"omega_g": w}, gyro_offset=False).up) for w in 0.05 * 2.0 ** np.arange(7))
     vqf = error(Rotation.from_quat(peer_quaternions("vqf", gyr, acc, FS), scalar_first=True).inv().apply([0, 0, 1]))
     print(f"δv {delta_v} m/s/√Hz, rotation {rot_rms} rad/s: defaults {ours:.3f}°, best fixed {best:.3f}°, "
           f"vqf {vqf:.3f}°")
@@ -134,8 +135,8 @@ def test_with_a_real_gyro_the_defaults_meet_the_best_fixed_filter_and_beat_vqf(d
 def test_offline_local_smoother_meets_the_smoother_optimum():
     motion, gyr, acc = _human(0.25)
     stop = len(acc) - SETTLE
-    online = _rms_deg(estimate(gyr, acc, FS, "wiener", {"scale_error": 0.0}), motion, stop)
-    offline = _rms_deg(estimate(gyr, acc, FS, "wiener", {"scale_error": 0.0}, offline=True), motion, stop)
+    online = _rms_deg(estimate(gyr, acc, FS, "wiener", {"scale_error": 0.0}, gyro_offset=False), motion, stop)
+    offline = _rms_deg(estimate(gyr, acc, FS, "wiener", {"scale_error": 0.0}, offline=True, gyro_offset=False), motion, stop)
     optimum = math.degrees(accuracy.smoother_rms_attitude_error(DELTA_N, 0.25, 1.0, 9.81))
     print(f"offline {offline:.3f}° (smoother optimum {optimum:.3f}°), online {online:.3f}°")
     assert abs(offline / optimum - 1) < 0.10
@@ -145,7 +146,7 @@ def test_offline_local_smoother_meets_the_smoother_optimum():
 @pytest.mark.parametrize("params", [{"stationary": 0.5}, {"scale_error": -0.01}, {"tau_noise": 0.0}])
 def test_bad_local_parameters_are_refused(params):
     with pytest.raises(ValueError):
-        estimate(np.zeros((5, 3)), np.tile([0.0, 0.0, 9.81], (5, 1)), FS, "wiener", params)
+        estimate(np.zeros((5, 3)), np.tile([0.0, 0.0, 9.81], (5, 1)), FS, "wiener", params, gyro_offset=False)
 
 
 def test_a_start_under_strong_acceleration_settles():
@@ -154,7 +155,7 @@ def test_a_start_under_strong_acceleration_settles():
     a quiet gyro (so a slow filter), the error meets eq. 46 once the filter has settled."""
     quiet = math.radians(0.02)
     motion, gyr, acc = _human(1.0, duration=1500.0, seed=3, delta_n=quiet)
-    err = inclination_error(estimate(gyr, acc, FS, "wiener", {"delta_n": quiet, "scale_error": 0.0}).gravity,
+    err = inclination_error(estimate(gyr, acc, FS, "wiener", {"delta_n": quiet, "scale_error": 0.0}, gyro_offset=False).gravity,
                             motion.up)
     optimum = math.degrees(accuracy.rms_attitude_error(quiet, 1.0, 1.0, 9.81))
     settled = math.degrees(rms(err[SETTLE:]))

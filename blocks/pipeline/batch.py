@@ -1,0 +1,225 @@
+"""The causal pipeline over whole recordings (blocks.pipeline.causal as one block of rows),
+and the batch-only offline additions: the smoother, the gyro offset and the heading from
+passes forward and backward in time, and delays measured from the whole recording."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Mapping
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from attitude_fmu.blocks.filters.sensor_frame import start_gravity, time_reversed
+from attitude_fmu.blocks.methods.registry import METHODS, KernelStepper
+from attitude_fmu.blocks.methods.registry import method as get_method
+from attitude_fmu.blocks.pipeline.causal import Pipeline, State, Step, at, configure, run, sample_timing
+from attitude_fmu.blocks.stages import heading as heading_stage
+from attitude_fmu.blocks.stages.delays import mag_delay
+from attitude_fmu.blocks.stages.gyro_offset import correct as correct_gyro
+from attitude_fmu.blocks.stages.hard_iron import back_dated
+from attitude_fmu.blocks.stages.heading import with_magnetometer
+from attitude_fmu.blocks.stages.timing import carry_forward_rows
+
+
+@dataclass
+class AttitudeEstimate:
+    """Per-sample output of an estimator.
+
+    gravity: N×3 gravity estimate ĝ in sensor coordinates, m/s² (points up);
+    quat: N×4 orientation [w, x, y, z], sensor → earth (heading from integrated gyro).
+    """
+
+    gravity: np.ndarray
+    quat: np.ndarray
+    offset: np.ndarray | None = None  # N×3 gyro-offset estimate, rad/s, when one was made
+    mag_accepted: np.ndarray | None = None  # N, magnetometer samples the heading used
+    mag_offset: np.ndarray | None = None  # N×3, µT, hard-iron offset estimate (blocks.stages.hard_iron)
+    mag_delay: np.ndarray | None = None  # N, s, the magnetometer's delay behind the gyro the heading allowed for
+    mag_delay_source: str | None = None  # "given", "online" (blocks.stages.mag_delay) or "measured" (whole recording)
+
+    @property
+    def up(self) -> np.ndarray:
+        """N×3 unit up-vector in sensor coordinates."""
+        return self.gravity / np.linalg.norm(self.gravity, axis=1, keepdims=True)
+
+
+def check_imu(gyr, acc, fs: float) -> tuple[np.ndarray, np.ndarray]:
+    """Validated contiguous float copies of N×3 gyro (rad/s) and accelerometer (m/s²)."""
+    if not (isinstance(fs, (int, float)) and math.isfinite(fs) and fs > 0):
+        raise ValueError(f"sample rate fs must be a finite positive number of Hz, got {fs!r}")
+    arrays = []
+    for name, data in (("gyr", gyr), ("acc", acc)):
+        a = np.asarray(data, dtype=float)
+        if a.ndim != 2 or a.shape[1] != 3 or a.shape[0] == 0:
+            raise ValueError(f"{name} must have shape (N, 3) with N ≥ 1, got {a.shape}")
+        bad = ~np.isfinite(a)
+        if bad.any():
+            row = int(np.argwhere(bad)[0][0])
+            raise ValueError(f"{name} has {int(bad.sum())} non-finite values (first at sample {row})")
+        arrays.append(np.ascontiguousarray(a))
+    if arrays[0].shape != arrays[1].shape:
+        raise ValueError(f"gyr and acc differ in length: {arrays[0].shape[0]} vs {arrays[1].shape[0]}")
+    return arrays[0], arrays[1]
+
+
+def check_mag(mag, n: int) -> np.ndarray:
+    """A validated contiguous float copy of the magnetometer (n×3, µT; a row with a NaN is a missing sample)."""
+    mag = np.ascontiguousarray(mag, dtype=float)
+    if mag.shape != (n, 3):
+        raise ValueError(f"mag must have the shape {(n, 3)}, got {mag.shape}")
+    infinite = int(np.isinf(mag).sum())
+    if infinite:
+        raise ValueError(f"mag has {infinite} infinite values (NaN marks a missing sample)")
+    if np.isnan(mag).any(axis=1).all():
+        raise ValueError("mag has no sample without NaN: estimate without it (--heading gyro, or mag=None)")
+    return mag
+
+
+def check_options(method: str = "wiener", params: Mapping[str, float] | None = None, offline: bool = False,
+                  gyro_offset: bool = True, mag: bool = False, latency: float = 0.0, gyr_samples: str = "mean",
+                  acc_samples: str = "point") -> Pipeline:
+    """Refuse what estimate() would refuse of its options, before any data is read: an
+    unknown method, a parameter no running stage has or a value out of range, --offline
+    with a method that is not an earth-frame filter, a latency, gyr_samples or acc_samples
+    out of range. mag: whether a magnetometer will be given. Returns the pipeline
+    (blocks.pipeline.causal.configure)."""
+    pipeline = configure(method, params, gyro_offset, mag, latency, gyr_samples, acc_samples)
+    if offline and not get_method(method).is_sensor_frame:
+        raise ValueError(f"offline smoothing needs an earth-frame filter method "
+                         f"({', '.join(n for n, m in METHODS.items() if m.is_sensor_frame)}), not {method!r}")
+    return pipeline
+
+
+def estimate(
+    gyr, acc, fs: float, method: str = "wiener", params: Mapping[str, float] | None = None,
+    initial_gravity=None, offline: bool = False, gyro_offset: bool = True, mag=None, latency: float = 0.0,
+    gyr_samples: str = "mean", acc_samples: str = "point",
+) -> AttitudeEstimate:
+    """Estimate attitude over a recording: gyr N×3 rad/s, acc N×3 m/s², fs in Hz.
+
+    The causal pipeline (blocks.pipeline.causal) over every sample: params are the
+    documented parameters of the method (blocks.methods.registry), of the gyro-offset
+    estimator when it runs and of the heading estimator when mag is given
+    (blocks.pipeline.causal.split_params), defaults otherwise. The filter starts at rest
+    on initial_gravity (m/s², sensor coordinates, before the first sample), by default the
+    first accelerometer sample turned back by the first gyro sample
+    (blocks.filters.sensor_frame.start_gravity). gyro_offset (default on, as `attitude
+    estimate` and the FMU): estimate the gyro offset at rest and while moving and remove it
+    (blocks.stages.gyro_offset; the estimate is returned as `offset`). mag (N×3, µT; rows
+    with a NaN are missing samples): heading from the magnetometer with a guard against
+    disturbances (blocks.stages.heading); without it the heading is the gyro's (6D). The
+    magnetometer's delay behind the gyro, unless given as the parameter mag_delay, is
+    estimated online (blocks.stages.mag_delay); `mag_delay` holds it per sample. latency
+    (s): the IMU's delay behind the motion; the estimate is carried forward over it with
+    the (offset-free) gyro (blocks.stages.timing). gyr_samples: "mean" (the project's
+    convention: sample k is the mean rate over the sample time before it) or "point" (the
+    rate at t_k, turned into means first). acc_samples: "point" (the convention: the
+    specific force at t_k) or "mean" (over the sample time before it, turned into the
+    sensor frame at t_k first; blocks.stages.timing).
+
+    offline: the batch-only additions (smoothed). The method's earth-frame filter runs
+    forward, then backward over the forward estimate (for `wiener` the non-causal Wiener
+    smoother, see blocks.filters.accuracy.smoother_mean_square_gravity_error); the gyro
+    offset comes from passes forward and backward in time; the magnetometer's delay is
+    measured from the whole recording (blocks.stages.delays.mag_delay; 0 where it cannot
+    be or comes out negative) and each hard-iron offset the heading stage took or dropped
+    holds from where the field changed (blocks.stages.hard_iron.back_dated).
+    """
+    pipeline = check_options(method, params, offline, gyro_offset, mag is not None, latency, gyr_samples,
+                             acc_samples)
+    gyr, acc = check_imu(gyr, acc, fs)
+    mag = None if mag is None else check_mag(mag, len(gyr))
+    step = at(pipeline, 1.0 / fs)
+    if offline:
+        return smoothed(pipeline, step, gyr, acc, mag, initial_gravity)
+    rows = run(pipeline, step, State(), gyr, acc, mag, initial_gravity=initial_gravity)
+    return AttitudeEstimate(rows.gravity, rows.quat, rows.offset, rows.mag_accepted, rows.mag_offset, rows.mag_delay,
+                            _mag_delay_source(pipeline, offline=False))
+
+
+def _mag_delay_source(pipeline: Pipeline, offline: bool) -> str | None:
+    if pipeline.heading_params is None:
+        return None
+    return "given" if pipeline.heading_params.get("mag_delay") is not None else "measured" if offline else "online"
+
+
+def smoothed(pipeline: Pipeline, step: Step, gyr, acc, mag, initial_gravity=None) -> AttitudeEstimate:
+    """The offline estimate (see estimate): the pipeline's stages in their order, the
+    gyro offset, the method and the heading each replaced by its offline form."""
+    fs = 1.0 / step.Ts
+    gyr, acc = sample_timing(pipeline, step, State(), gyr, acc)
+    offset = None
+    if pipeline.offset_params is not None:
+        gyr, offset = correct_gyro(gyr, acc, fs, pipeline.offset_params, offline=True)
+    stepper = step.stepper
+    if initial_gravity is None:
+        initial_gravity = start_gravity(gyr[0], acc[0], step.Ts)
+    gyr_back = time_reversed(gyr)
+    if isinstance(stepper, KernelStepper):
+        # wiener's local densities: both passes run at the lower of the break frequencies
+        # estimated causally forward and backward in time
+        omega = np.minimum(_run_local(stepper, gyr, acc, initial_gravity)[1],
+                           _run_local(stepper, gyr_back, acc[::-1], acc[-1])[1][::-1])
+        forward = AttitudeEstimate(*_run_local(stepper, gyr, acc, initial_gravity, omega)[0])
+        backward = _run_local(stepper, gyr_back, forward.gravity[::-1], forward.gravity[-1], omega[::-1])[0][0]
+    else:
+        forward = _run(stepper, gyr, acc, initial_gravity)
+        backward = _run(stepper, gyr_back, np.ascontiguousarray(forward.gravity[::-1]), forward.gravity[-1]).gravity
+    gravity = backward[::-1].copy()
+    est = AttitudeEstimate(gravity, level_onto(forward.quat, gravity), offset)
+    if mag is not None:
+        _offline_heading(est, pipeline, mag, gyr, fs)
+    if pipeline.latency:
+        carry_forward_rows(est.quat, est.gravity, gyr, pipeline.latency)
+    return est
+
+
+def _offline_heading(est: AttitudeEstimate, pipeline: Pipeline, mag, gyr, fs: float) -> None:
+    """The heading stage over the whole recording, in place: the magnetometer's delay
+    measured unless given, then once more with each hard-iron offset from where the field
+    changed, on the field freed of it."""
+    params = dict(pipeline.heading_params)
+    est.mag_delay_source = _mag_delay_source(pipeline, offline=True)
+    if est.mag_delay_source == "measured":
+        params["mag_delay"] = max(mag_delay(gyr, mag, fs) or 0.0, 0.0)
+    quat = est.quat
+    est.quat, est.mag_accepted, est.mag_offset, est.mag_delay = with_magnetometer(quat, mag, fs, params)
+    if est.mag_offset.any():  # again, with each hard-iron offset from where the field changed
+        est.mag_offset = back_dated(mag, est.mag_offset, fs, heading_stage.resolve(params))
+        freed = mag - est.mag_offset
+        if est.mag_delay_source == "measured":  # the offset no longer hides the delay
+            params["mag_delay"] = max(mag_delay(gyr, freed, fs) or 0.0, 0.0)
+        est.quat, est.mag_accepted, _, est.mag_delay = with_magnetometer(quat, freed, fs,
+                                                                         {**params, "mag_cal_time": 0.0})
+
+
+def _run_local(step, gyr, acc, initial_gravity, omega=None):
+    """((gravity, quat), break frequencies) of blocks.methods.wiener_local over gyr, acc; omega
+    (N, rad/s) imposes the break frequencies."""
+    state = step.initial_state(initial_gravity)
+    acc = np.ascontiguousarray(acc)
+    gravity, quat, used = np.empty_like(acc), np.empty((acc.shape[0], 4)), np.empty(acc.shape[0])
+    imposed = np.empty(0) if omega is None else np.ascontiguousarray(omega)
+    step.module.run_schedule(state, step.coef, np.ascontiguousarray(gyr), acc, gravity, quat, imposed, used)
+    return (gravity, quat), used
+
+
+def _run(step, gyr, acc, initial_gravity) -> AttitudeEstimate:
+    state = step.initial_state(initial_gravity)
+    gravity = np.empty_like(acc)
+    quat = np.empty((acc.shape[0], 4))
+    step.run(state, gyr, acc, gravity, quat)
+    return AttitudeEstimate(gravity, quat)
+
+
+def level_onto(quat, gravity) -> np.ndarray:
+    """Orientations (N×4) turned by the smallest earth-frame rotation that takes each
+    estimated up (gravity, sensor coordinates) onto earth up; heading is kept."""
+    rot = Rotation.from_quat(quat, scalar_first=True)
+    up = rot.apply(gravity / np.linalg.norm(gravity, axis=1, keepdims=True))
+    horizontal = np.hypot(up[:, 0], up[:, 1])
+    angle = np.arctan2(horizontal, up[:, 2])
+    scale = np.divide(angle, horizontal, out=np.zeros_like(angle), where=horizontal > 0)
+    correction = Rotation.from_rotvec(np.column_stack([up[:, 1] * scale, -up[:, 0] * scale, np.zeros_like(angle)]))
+    return (correction * rot).as_quat(scalar_first=True)

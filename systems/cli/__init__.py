@@ -1,0 +1,1 @@
+"""The `attitude` command line: its parser, its commands and their plots."""

@@ -1,0 +1,542 @@
+"""The `attitude` command line: estimate, evaluate, plot, table1, verify, compare, bode, bench."""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from attitude_fmu.blocks.methods.registry import METHODS
+from attitude_fmu.blocks.methods.registry import method as known_method
+from attitude_fmu.blocks.pipeline.causal import ESTIMATORS
+from attitude_fmu.blocks.stages.timing import ACC_SAMPLES, GYR_SAMPLES, check_latency
+from attitude_fmu.systems.recordings.reading import MAX_GAP_S
+from attitude_fmu.systems.recordings.recording import (
+    ACC_UNITS,
+    GYR_UNITS,
+    KNOWN_COLUMNS,
+    MAG_UNITS,
+    MAT_VARIABLES,
+    MOVEMENT_COLUMN,
+    REF_COLUMNS,
+    T_UNITS,
+)
+
+EXIT_BAD_INPUT = 2
+EXIT_CHECK_FAILED = 1
+TABLE1_TOLERANCE = 0.07  # simulated cells must lie within ±7 % of eq. 50
+
+
+def _param(text: str) -> tuple[str, float]:
+    name, sep, value = text.partition("=")
+    if not sep:
+        raise argparse.ArgumentTypeError(f"expected NAME=VALUE, got {text!r}")
+    try:
+        number = float(value)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{name}: {value!r} is not a number") from None
+    return name.strip(), number
+
+
+def _column(text: str) -> tuple[str, str]:
+    name, sep, header = text.partition("=")
+    if not sep or not header.strip():
+        raise argparse.ArgumentTypeError(f"expected NAME=HEADER (e.g. gyr_x=Gyr_X), got {text!r}")
+    if name.strip() not in KNOWN_COLUMNS + MAT_VARIABLES:
+        raise argparse.ArgumentTypeError(f"{name!r} is not a column read; NAME is one of {', '.join(KNOWN_COLUMNS)} "
+                                         f"(a CSV) or {', '.join(MAT_VARIABLES)} (a .mat)")
+    return name.strip(), header.strip()
+
+
+def _axes(text: str) -> str:
+    from attitude_fmu.systems.recordings.axes import parse_axes
+
+    try:
+        parse_axes(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+    return text
+
+
+def _method_help() -> str:
+    lines = []
+    stages = [(f"{m.name}: {m.summary}", m.params) for m in METHODS.values()]
+    runs_with = ("--gyro-offset on", "--heading mag and a magnetometer")  # in the order of ESTIMATORS
+    stages += [(f"{name} ({when}):", ps) for (name, ps), when in zip(ESTIMATORS.items(), runs_with)]
+    for title, params in stages:
+        lines.append(title)
+        for p in params:
+            default = "unset" if p.default is None else f"{p.default:g}"
+            lines.append(f"    {p.name} [{p.unit}] (default {default}): {p.doc}")
+    return "\n".join(lines)
+
+
+def _add_real_data_flags(parser) -> None:
+    parser.add_argument("--offline", action="store_true",
+                        help="forward-backward smoothing of the earth-frame filter (wiener: the Wiener smoother)")
+    parser.add_argument("--gyro-offset", default="on", choices=["on", "off"],
+                        help="estimate and remove the gyro offset, at rest and while moving (default on)")
+    parser.add_argument("--heading", default="mag", choices=["mag", "gyro"],
+                        help="heading from the magnetometer when the input has one (default), or the gyro's (6D)")
+
+
+def _add_input_flags(parser) -> None:
+    parser.add_argument("--fs", type=float, help="sample rate in Hz (required when a CSV has no t column)")
+    parser.add_argument("--gyr-unit", default="rad/s", choices=list(GYR_UNITS), help="gyro unit (default rad/s)")
+    parser.add_argument("--acc-unit", default="m/s2", choices=list(ACC_UNITS),
+                        help="accelerometer unit (default m/s2; g and mg in standard gravity, 9.80665 m/s²)")
+    parser.add_argument("--mag-unit", default="uT", choices=list(MAG_UNITS), help="magnetometer unit (default uT)")
+    parser.add_argument("--t-unit", default="s", choices=list(T_UNITS), help="unit of a CSV's t column (default s)")
+    parser.add_argument("--column", type=_column, action="append", default=[], metavar="NAME=HEADER",
+                        help="read the CSV's column HEADER as NAME (t, gyr_x, acc_x, mag_x, ref_q_w, movement, ...), "
+                             "or a .mat's variable HEADER as NAME (imu_gyr, imu_acc, imu_mag, opt_quat, movement, "
+                             "sampling_rate), for a file with other names; repeatable")
+    for sensor, what in (("gyr", "gyro"), ("acc", "accelerometer"), ("mag", "magnetometer")):
+        parser.add_argument(f"--{sensor}-axes", type=_axes, metavar="MAP",
+                            help=f"the {what}'s axes as the file's, signed: y,x,-z takes x from the file's y, y from "
+                                 "its x and z from its −z (default x,y,z; one that begins with a minus as "
+                                 f"--{sensor}-axes=-x,y,z); a sensor that does not turn as the gyro says is noted "
+                                 "with the maps that fit")
+    parser.add_argument("--max-gap", type=float, default=MAX_GAP_S, metavar="S",
+                        help="longest run of samples missing from a CSV's time stamps, or of gyro or "
+                             "accelerometer values that are not finite, that is filled in (interpolated "
+                             f"linearly; default {MAX_GAP_S:g} s)")
+    parser.add_argument("--gyr-samples", default="mean", choices=list(GYR_SAMPLES),
+                        help="mean: a gyro sample is the mean rate over the sample time before it (default; the "
+                             "project's convention); point: the rate at the sample's time (simulations that sample "
+                             "ω(t), most IMU drivers), turned into means by the trapezoid")
+    parser.add_argument("--acc-samples", default="point", choices=list(ACC_SAMPLES),
+                        help="point: an accelerometer sample is the specific force at the sample's time (default; "
+                             "the project's convention); mean: its mean over the sample time before it (a "
+                             "recording averaged down to a lower rate, a sensor that averages it as the gyro), "
+                             "turned to the sample's time by half the step's rotation")
+    parser.add_argument("--latency", type=float, default=0.0, metavar="S",
+                        help="the IMU's delay behind the motion in seconds (its filters' group delay), counted in "
+                             "the means the estimator takes (point samples taken S late, with --gyr-samples point): "
+                             "estimates are carried forward over it with the gyro (default 0; attitude evaluate "
+                             "measures it against the reference)")
+
+
+def _timing(args) -> dict:
+    """The sample-timing flags as keyword arguments of estimate, evaluate, plot and check_options."""
+    return {"latency": args.latency, "gyr_samples": args.gyr_samples, "acc_samples": args.acc_samples}
+
+
+def _read_options(args) -> dict:
+    names = [name for name, _ in args.column]
+    twice = sorted({name for name in names if names.count(name) > 1})
+    if twice:
+        raise ValueError(f"--column gives {', '.join(twice)} more than once")
+    return {"fs": args.fs, "gyr_unit": args.gyr_unit, "acc_unit": args.acc_unit, "mag_unit": args.mag_unit,
+            "max_gap": args.max_gap, "t_unit": args.t_unit, "columns": dict(args.column),
+            "gyr_axes": args.gyr_axes, "acc_axes": args.acc_axes, "mag_axes": args.mag_axes}
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="attitude", description="IMU attitude estimators (Rizun's optimal Wiener filter and peers).",
+    )
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    est = sub.add_parser(
+        "estimate", help="estimate attitude over a recording",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        epilog="methods and estimators, and their parameters (a name under several sets it in each):\n" + _method_help(),
+    )
+    est.add_argument("input", nargs="+", help="CSV (t,gyr_x,gyr_y,gyr_z,acc_x,acc_y,acc_z[,mag_x,mag_y,mag_z]; "
+                     "separated by commas, semicolons or tabs) or BROAD .mat; several: each is estimated "
+                     "with the same flags")
+    est.add_argument("--out", required=True, help="output CSV: t,q_w,q_x,q_y,q_z,g_x,g_y,g_z; or a folder that receives "
+                     "NAME.csv for input NAME.csv or NAME.mat (with several inputs, made if absent)")
+    est.add_argument("--euler", action="store_true",
+                     help="add roll_deg,pitch_deg,yaw_deg to the output (Z-Y-X sequence of q, degrees)")
+    est.add_argument("--offsets", action="store_true",
+                     help="add gyr_offset_x,gyr_offset_y,gyr_offset_z (rad/s, the gyro-offset estimate after each "
+                          "sample; 0 with --gyro-offset off) and, with magnetometer heading, mag_offset_x,mag_offset_y,"
+                          "mag_offset_z (µT, the hard-iron estimate) and mag_delay (s, the magnetometer's delay "
+                          "behind the gyro allowed for)")
+    est.add_argument("--method", default="wiener", choices=sorted(METHODS))
+    est.add_argument("--param", type=_param, action="append", default=[], metavar="NAME=VALUE",
+                     help="parameter of the method, the gyro-offset or the heading estimator, in the unit listed "
+                          "below; repeatable")
+    _add_input_flags(est)
+    _add_real_data_flags(est)
+
+    ev = sub.add_parser("evaluate", help="errors against an optical reference (BROAD .mat, or a CSV with "
+                                         f"{','.join(REF_COLUMNS)}[,{MOVEMENT_COLUMN}]), beside vqf and madgwick")
+    ev.add_argument("files", nargs="+", metavar="FILE")
+    ev.add_argument("--method", default="wiener", choices=sorted(METHODS))
+    ev.add_argument("--param", type=_param, action="append", default=[], metavar="NAME=VALUE")
+    ev.add_argument("--json", action="store_true")
+    ev.add_argument("--start-in-movement", type=float, metavar="S",
+                    help="begin each recording S seconds into its movement phase: no rest before, "
+                         "a first sample in motion (a test of start-up and offset tracking)")
+    _add_input_flags(ev)
+    _add_real_data_flags(ev)
+
+    pl = sub.add_parser("plot", help="a recording's error over time and its spectrum against eq. 42 (PNG); "
+                        "without a reference, the estimate's angles over time")
+    pl.add_argument("file", metavar="FILE")
+    pl.add_argument("--method", default="wiener", choices=sorted(METHODS))
+    pl.add_argument("--out", required=True, help="PNG to write")
+    pl.add_argument("--param", type=_param, action="append", default=[], metavar="NAME=VALUE")
+    pl.add_argument("--offline", action="store_true")
+    pl.add_argument("--gyro-offset", default="on", choices=["on", "off"])
+    pl.add_argument("--heading", default="mag", choices=["mag", "gyro"],
+                    help="with a magnetometer in the recording, also the heading error (default), or not")
+    _add_input_flags(pl)
+
+    t1 = sub.add_parser("table1", help="Rizun's Table 1: analytic (eq. 50) and simulated RMS attitude error")
+    t1.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    t1.add_argument("--duration", type=float, default=20000.0, help="simulated seconds per cell (default 20000)")
+    t1.add_argument("--fs", type=float, default=100.0, help="simulation sample rate, Hz (default 100)")
+    t1.add_argument("--seed", type=int, default=0)
+
+    vf = sub.add_parser("verify", help="co-simulate every profile with every estimator as FMUs; exit 1 if a bound is missed")
+    vf.add_argument("--json", action="store_true")
+    vf.add_argument("--fmu-dir", default="dist", help="where the FMUs are, built there if missing or built from other sources (default dist/)")
+    vf.add_argument("--rebuild", action="store_true", help="build the FMUs even if present")
+    vf.add_argument("--profile", action="append", help="only this profile (repeatable)")
+    vf.add_argument("--method", action="append", help="only this method (repeatable)")
+
+    cp = sub.add_parser("compare", help="every estimator and the peers vqf, madgwick on every motion profile")
+    cp.add_argument("--profile", action="append", help="only this profile (repeatable)")
+    cp.add_argument("--json", action="store_true")
+    cp.add_argument("--gyro-noise", type=float, default=0.02, metavar="DEG_S_RTHZ",
+                    help="the simulated gyro's white noise, °/s/√Hz (default 0.02)")
+    cp.add_argument("--acc-noise", type=float, default=0.002, metavar="M_S2_RTHZ",
+                    help="the simulated accelerometer's white noise, m/s²/√Hz (default 0.002)")
+    cp.add_argument("--gyro-scale-error", type=float, default=0.0, metavar="FRACTION",
+                    help="rms of each element of the simulated gyro's scale-factor and misalignment matrix, "
+                         "drawn once (1 = 100 %%; default 0, an ideal scale)")
+    cp.add_argument("--offline", action="store_true",
+                    help="also the smoothers: every earth-frame method offline, and vqf's offline estimate")
+
+    bd = sub.add_parser("bode", help="frequency response of a method's filter (tseng: also Tseng Figs. 6-7)")
+    bd.add_argument("--method", default="tseng", choices=sorted(m for m in METHODS if METHODS[m].is_sensor_frame))
+    bd.add_argument("--out", help="PNG to write (default bode_METHOD.png)")
+
+    bn = sub.add_parser("bench", help="samples per second of the batch estimator, vqf and ahrs Madgwick")
+    bn.add_argument("--json", action="store_true")
+    bn.add_argument("--samples", type=int, default=100_000)
+    bn.add_argument("--fmu", action="store_true",
+                    help="per-step cost of AttitudeEstimator.fmu against a no-op FMU of the same interface")
+    bn.add_argument("--repeat", type=int, default=10, help="interleaved rounds; each method's best run counts (default 10)")
+    return parser
+
+
+def _check_out(path, source=None, figure: bool = False) -> None:
+    """Refuse, before any work is done, an output file whose folder does not exist, that is
+    a folder, or that is the input file source (writing it would lose the recording); a
+    figure (figure=True) also in a format matplotlib cannot write."""
+    folder = Path(path).absolute().parent
+    if not folder.is_dir():
+        raise ValueError(f"cannot write {path}: there is no folder {folder}")
+    if Path(path).is_dir():
+        raise ValueError(f"cannot write {path}: it is a folder; give a file name")
+    if source is not None and Path(path).resolve() == Path(source).resolve():
+        raise ValueError(f"cannot write {path}: it is the input; choose another --out")
+    if figure:
+        from matplotlib.figure import Figure
+
+        formats = Figure().canvas.get_supported_filetypes()
+        if Path(path).suffix.lstrip(".").lower() not in formats:
+            raise ValueError(f"cannot write {path}: a figure's file name ends in one of "
+                             f"{', '.join('.' + f for f in sorted(formats))} (e.g. .png)")
+
+
+def _estimate_outputs(inputs, out) -> list:
+    """The output file of each input: out itself for one input, unless out is a folder; for
+    several, out is a folder (made here if absent, its parent must exist). In a folder,
+    input NAME.ext gives out/NAME.csv. Refused before any work: two inputs of one name,
+    an output that is an input."""
+    if len(inputs) == 1 and not Path(out).is_dir():
+        _check_out(out, inputs[0])
+        return [out]
+    folder = Path(out)
+    if folder.exists() and not folder.is_dir():
+        raise ValueError(f"cannot write into {out}: with {len(inputs)} inputs --out is a folder, and it is a file")
+    stems = [Path(path).stem for path in inputs]
+    repeated = sorted({stem for stem in stems if stems.count(stem) > 1})
+    if repeated:
+        raise ValueError(f"inputs share the names {', '.join(repeated)}: their outputs in {out} would overwrite "
+                         "each other; estimate them in separate runs")
+    if not folder.is_dir():
+        _check_out(folder)  # the folder to make: its parent must exist
+    outputs = [folder / f"{stem}.csv" for stem in stems]
+    for path in outputs:
+        if any(path.resolve() == Path(source).resolve() for source in inputs):
+            raise ValueError(f"cannot write {path}: it is an input; choose another --out")
+        if path.is_dir():
+            raise ValueError(f"cannot write {path}: it is a folder")
+    folder.mkdir(exist_ok=True)
+    return outputs
+
+
+def cmd_estimate(args) -> int:
+    """Each input in turn; one that fails is reported and the others still run (exit 2)."""
+    from attitude_fmu.blocks.pipeline.batch import check_options
+
+    check_options(args.method, dict(args.param), args.offline, args.gyro_offset == "on", args.heading == "mag",
+                  **_timing(args))
+    outputs = _estimate_outputs(args.input, args.out)
+    failed = []
+    for number, (path, out) in enumerate(zip(args.input, outputs), 1):
+        prefix = f"[{number}/{len(outputs)}] " if len(outputs) > 1 else ""
+        try:
+            _estimate_one(args, path, out, prefix)
+        except (ValueError, OSError, RuntimeError) as exc:
+            if len(outputs) == 1:
+                raise
+            print(f"attitude: {prefix}error: {exc}", file=sys.stderr, flush=True)
+            failed.append(path)
+    if failed:
+        written = f"the others are in {args.out}" if len(failed) < len(outputs) else "none was written"
+        print(f"attitude: error: {len(failed)} of {len(outputs)} inputs failed ({', '.join(failed)}); {written}",
+              file=sys.stderr)
+        return EXIT_BAD_INPUT
+    return 0
+
+
+def _estimate_one(args, path, out, prefix: str) -> None:
+    from attitude_fmu.blocks.pipeline.batch import estimate
+    from attitude_fmu.systems.recordings.checks import field_norm_note
+    from attitude_fmu.systems.recordings.reading import read_recording
+    from attitude_fmu.systems.recordings.recording import print_notes
+    from attitude_fmu.systems.recordings.writing import write_estimate
+
+    clock = time.perf_counter()
+
+    def progress(text):  # reading and writing take about 3 s per million samples
+        nonlocal clock
+        now = time.perf_counter()
+        print(f"attitude: {prefix}{text} ({now - clock:.1f} s)", file=sys.stderr, flush=True)
+        clock = now
+
+    rec = read_recording(path, **_read_options(args))
+    progress(f"read {len(rec.gyr)} samples at {rec.fs:g} Hz from {path}")
+    print_notes(rec.notes + ([field_norm_note(rec)] if args.heading == "mag" else []))
+    result = estimate(rec.gyr, rec.acc, rec.fs, args.method, dict(args.param), offline=args.offline,
+                      gyro_offset=args.gyro_offset == "on", mag=rec.mag if args.heading == "mag" else None,
+                      **_timing(args))
+    progress(f"estimated with {args.method}{' --offline' if args.offline else ''}")
+    rows = slice(None) if rec.filled is None else ~rec.filled  # the input's rows, not those filled in
+    extra = {}
+    if args.offsets:
+        extra["gyr_offset"] = np.zeros_like(rec.gyr) if result.offset is None else result.offset
+        if result.mag_offset is not None:
+            extra["mag_offset"], extra["mag_delay"] = result.mag_offset, result.mag_delay
+    write_estimate(out, rec.t[rows], result.quat[rows], result.up[rows], euler=args.euler,
+                   extra={name: values[rows] for name, values in extra.items()})
+    progress(f"wrote {out}")
+    if result.offset is not None:
+        print(f"attitude: {prefix}gyro offset estimate at the end "
+              f"({', '.join(f'{v:.3f}' for v in np.degrees(result.offset[-1]))}) °/s", file=sys.stderr)
+    if result.mag_accepted is not None:
+        sampled = np.isfinite(rec.mag).all(axis=1)  # rows where a slower magnetometer has a sample
+        print(f"attitude: {prefix}magnetometer samples used for heading "
+              f"{100 * result.mag_accepted[sampled].mean():.0f} %, hard-iron offset at the end "
+              f"({', '.join(f'{v:.1f}' for v in result.mag_offset[-1])}) µT; {_mag_delay_text(result)}",
+              file=sys.stderr)
+
+
+def _mag_delay_text(result) -> str:
+    delay, source = 1e3 * result.mag_delay[-1], result.mag_delay_source
+    if source == "given":
+        return f"its delay behind the gyro {delay:.1f} ms (given)"
+    if delay == 0.0:
+        return f"no delay behind the gyro that the recording shows{' so far' if source == 'online' else ''} " \
+               "(--param mag_delay=S sets one)"
+    how = "estimated online, at the end" if source == "online" else "measured from the whole recording"
+    return f"its delay behind the gyro {delay:.1f} ms ({how}; --param mag_delay=S sets it)"
+
+
+def cmd_evaluate(args) -> int:
+    from attitude_fmu.systems.evaluation.evaluate import METRICS, evaluate
+
+    try:
+        import ahrs  # noqa: F401
+        import vqf  # noqa: F401
+    except ImportError as exc:
+        raise RuntimeError(f"attitude evaluate compares with vqf and ahrs ({exc}); "
+                           "install them with: pip install 'attitude-fmu[peers]'") from None
+    result = evaluate(args.files, args.method, dict(args.param), args.offline, args.gyro_offset == "on",
+                      args.heading == "mag", start_in_movement=args.start_in_movement,
+                      read_options=_read_options(args), **_timing(args))
+    if args.json:
+        print(json.dumps(result, indent=2))
+        return 0
+    labels = list(result["mean"])
+    print("RMSE over the movement phase, degrees: inclination / heading / total; IMU lag behind the reference, ms")
+    print(f"{'recording':>45} " + " ".join(f"{label:>22}" for label in labels) + f" {'lag':>6}")
+    rows = list(result["recordings"].items()) + [("mean", result["mean"])]
+    for name, table in rows:
+        cells = " ".join(f"{'/'.join(format(table[l][m], '.2f') for m in reversed(METRICS)):>22}" for l in labels)
+        lag = result["imu_latency_s"].get(name)
+        print(f"{name:>45} {cells} {'' if name == 'mean' else '     —' if lag is None else format(1e3 * lag, '6.2f')}"
+              .rstrip())
+    return 0
+
+
+def cmd_plot(args) -> int:
+    from attitude_fmu.systems.cli.plots import plot_recording
+
+    _check_out(args.out, args.file, figure=True)
+    result = plot_recording(args.file, args.out, args.method, dict(args.param), args.offline,
+                            args.gyro_offset == "on", args.heading == "mag", _read_options(args), **_timing(args))
+    if not result:
+        print(f"attitude: wrote {args.out} (no reference to measure errors against: the estimate's roll, pitch "
+              "and yaw over time)", file=sys.stderr)
+        return 0
+    heading = f", heading RMSE {result['heading_rmse_deg']:.2f}°" if "heading_rmse_deg" in result else ""
+    print(f"attitude: wrote {args.out} (inclination RMSE {result['inclination_rmse_deg']:.2f}°{heading})",
+          file=sys.stderr)
+    return 0
+
+
+def cmd_table1(args) -> int:
+    from attitude_fmu.systems.evaluation.experiments import table1
+
+    if not (args.duration > 0 and args.fs > 0):
+        raise ValueError("--duration and --fs must be positive")
+    rows = table1(duration=args.duration, fs=args.fs, seed=args.seed)
+    failed = [
+        (row, cell) for row in rows for cell in row["cells"]
+        if abs(cell["simulated_deg"] / cell["analytic_deg"] - 1) > TABLE1_TOLERANCE
+    ]
+    if args.json:
+        print(json.dumps(rows, indent=2))
+    else:
+        print("Rizun (2008) Table 1: RMS attitude error, analytic (eq. 50) | simulated, degrees "
+              f"(g = 9.8 m/s², {args.duration:g} s per cell at {args.fs:g} Hz)")
+        print(f"{'δn °/s/√Hz':>11} {'δv m/s/√Hz':>11} {'1/ω_g s':>8}  "
+              + "  ".join(f"{'a=' + format(c['a'], 'g'):>16}" for c in rows[0]["cells"]))
+        for row in rows:
+            cells = "  ".join(f"{c['analytic_deg']:7.3f} | {c['simulated_deg']:6.3f}" for c in row["cells"])
+            print(f"{row['delta_n_deg']:11.2f} {row['delta_v']:11.1f} {row['inv_omega_g_s']:8.2f}  {cells}")
+    if failed:
+        print(f"attitude: {len(failed)} simulated cells off eq. 50 by more than ±{TABLE1_TOLERANCE:.0%}",
+              file=sys.stderr)
+        return EXIT_CHECK_FAILED
+    return 0
+
+
+def cmd_verify(args) -> int:
+    from attitude_fmu.systems.fmi.build import ensure_built
+    from attitude_fmu.systems.fmi.verify import SCENARIOS, verify
+    from attitude_fmu.systems.simulation.motion import PROFILES
+
+    for name in args.profile or []:
+        if name not in SCENARIOS:
+            raise ValueError(f"unknown profile {name!r}; verified profiles: {', '.join(SCENARIOS)}")
+    for name in args.method or []:
+        known_method(name)  # refuses unknown names
+    fmu_dir = ensure_built(args.fmu_dir, args.rebuild, log=lambda m: print(f"attitude: {m}", file=sys.stderr))
+    rows = verify(fmu_dir, args.profile, args.method)
+    if args.json:
+        print(json.dumps({"rows": rows}, indent=2))
+    else:
+        print(f"{'profile':>15} {'method':>14} {'rms °':>8} {'max °':>8} {'mean °':>9}  {'bound °':>8} {'on':>4}  result")
+        for r in rows:
+            bound = "       —" if r["bound_deg"] is None else f"{r['bound_deg']:8.3g}"
+            result = "report" if r["bound_deg"] is None else "pass" if r["pass"] else "FAIL"
+            print(f"{r['profile']:>15} {r['method']:>14} {r['rms_deg']:8.3g} {r['max_deg']:8.3g} {r['mean_deg']:9.3g}"
+                  f"  {bound} {r['metric']:>4}  {result}")
+        print("profiles: " + "; ".join(f"{n}: {PROFILES[n].summary}" for n in dict.fromkeys(r["profile"] for r in rows)))
+    failed = [r for r in rows if not r["pass"]]
+    if failed:
+        print(f"attitude: {len(failed)} of {len(rows)} rows missed their bound", file=sys.stderr)
+        return EXIT_CHECK_FAILED
+    return 0
+
+
+def cmd_compare(args) -> int:
+    from attitude_fmu.systems.evaluation.compare import compare, imu_model
+    from attitude_fmu.systems.simulation.motion import profile as known_profile
+
+    for name in args.profile or []:
+        known_profile(name)  # refuses unknown names
+    imu = imu_model(args.gyro_noise, args.acc_noise, args.gyro_scale_error)
+    result = compare(args.profile, imu=imu, offline=args.offline)
+    if args.json:
+        print(json.dumps(result, indent=2))
+        return 0
+    print(f"inclination error, degrees: RMS / max / mean (bias); default parameters; gyro {args.gyro_noise:g} °/s/√Hz, "
+          f"scale error {args.gyro_scale_error:g}, accelerometer {args.acc_noise:g} m/s²/√Hz")
+    for profile, rows in result["profiles"].items():
+        print(f"\n{profile}")
+        for method, r in rows.items():
+            print(f"  {method:>19} {r['rms_deg']:8.3f} {r['max_deg']:8.3f} {r['mean_deg']:9.4f}")
+    return 0
+
+
+def cmd_bode(args) -> int:
+    from attitude_fmu.systems.cli.bode import plot
+
+    out = args.out or f"bode_{args.method}.png"
+    _check_out(out, figure=True)
+    plot(args.method, out)
+    print(f"attitude: wrote {out}", file=sys.stderr)
+    return 0
+
+
+def cmd_bench(args) -> int:
+    from attitude_fmu.systems.evaluation.bench import bench
+
+    if args.samples < 1000 or args.repeat < 1:
+        raise ValueError("--samples must be ≥ 1000 and --repeat ≥ 1")
+    if args.fmu:
+        from attitude_fmu.systems.evaluation.bench import bench_fmu
+
+        result = bench_fmu(steps=min(args.samples, 5000), repeat=args.repeat)
+        if args.json:
+            print(json.dumps(result, indent=2))
+        else:
+            print(f"{result['steps']} steps under fmpy, best of {args.repeat} interleaved rounds")
+            for name, us in result["us_per_step"].items():
+                print(f"{name:>18} {us:8.1f} µs/step")
+            print(f"{'ratio':>18} {result['ratio_vs_noop']:8.2f}")
+        return 0
+    result = bench(n=args.samples, repeat=args.repeat)
+    if args.json:
+        print(json.dumps(result, indent=2))
+    else:
+        print(f"{result['samples']} samples, best of up to {args.repeat} runs")
+        print(f"{'method':>18} {'samples/s':>14} {'vs vqf':>8} {'vs vqf_9d':>10}")
+        for name, rate in result["samples_per_s"].items():
+            print(f"{name:>18} {rate:14.4g} {result['ratio_vs_vqf'][name]:8.2f} {result['ratio_vs_vqf_9d'][name]:10.2f}")
+    return 0
+
+
+def main(argv=None) -> int:
+    args = build_parser().parse_args(argv)
+    handler = {"estimate": cmd_estimate, "evaluate": cmd_evaluate, "plot": cmd_plot, "table1": cmd_table1, "verify": cmd_verify, "compare": cmd_compare,
+               "bode": cmd_bode, "bench": cmd_bench}[args.command]
+    try:
+        if hasattr(args, "latency"):
+            check_latency(args.latency)  # before any input is read
+        return handler(args)
+    except (ValueError, OSError, RuntimeError) as exc:
+        print(f"attitude: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+
+
+def entry_point() -> None:
+    """The console script: main(), then an immediate exit where FMUs were loaded
+    (see systems.fmi.cosim.fmus_loaded)."""
+    code = main()
+    from attitude_fmu.systems.fmi.cosim import fmus_loaded
+
+    if fmus_loaded():
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(code)
+    sys.exit(code)
+
+
+if __name__ == "__main__":
+    entry_point()

@@ -1,0 +1,145 @@
+"""`attitude evaluate`: recordings with an optical reference (BROAD), errors as the
+dataset defines them, for a project method and, on the same samples, vqf online and
+offline and ahrs' Madgwick."""
+from __future__ import annotations
+
+import math
+import sys
+from dataclasses import replace
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from attitude_fmu.blocks.errors import quaternion_errors
+from attitude_fmu.blocks.pipeline.batch import check_options, estimate
+from attitude_fmu.blocks.stages.delays import best_shift
+from attitude_fmu.blocks.stages.timing import carry_forward_rows, interval_ends, interval_means
+from attitude_fmu.systems.evaluation.compare import peer_quaternions
+from attitude_fmu.systems.recordings.reading import read_recording
+from attitude_fmu.systems.recordings.recording import Recording, print_notes
+
+METRICS = ("total_rmse_deg", "heading_rmse_deg", "inclination_rmse_deg")
+LATENCY_SEARCH_S = 0.1  # imu_latency looks this far either way
+LATENCY_SAMPLES = 200_000  # at most this many gyro samples, evenly spread, enter imu_latency's fit
+
+
+def errors_on_movement(quat, rec: Recording) -> dict:
+    """RMSE (deg) of total, heading and inclination error over Recording.evaluated (the
+    movement phase where the reference is finite; BROAD's definitions, see
+    blocks.errors.quaternion_errors)."""
+    ok = rec.evaluated()
+    errors = quaternion_errors(quat[ok], rec.quat_ref[ok])
+    return {name: math.degrees(float(np.sqrt(np.mean(e**2)))) for name, e in zip(METRICS, errors)}
+
+
+def imu_latency(rec: Recording) -> float | None:
+    """The IMU's latency behind its reference (s, in blocks.stages.timing's convention): the
+    shift of the reference's mean rate over each sample time that best matches the gyro,
+    least squares over the movement phase (at most LATENCY_SAMPLES of it) within
+    ±LATENCY_SEARCH_S (blocks.stages.delays.best_shift).
+    None where the reference gives fewer than a second of rates or the best shift lies at
+    the search's edge."""
+    ok = np.isfinite(rec.quat_ref).all(axis=1)
+    rot = Rotation.from_quat(np.where(ok[:, None], rec.quat_ref, [1.0, 0.0, 0.0, 0.0]), scalar_first=True)
+    rate = np.full(rec.gyr.shape, np.nan)  # rate[k]: the reference's mean rate over (t_k−1, t_k]
+    rate[1:] = (rot[:-1].inv() * rot[1:]).as_rotvec() * rec.fs
+    rate[~(ok & np.roll(ok, 1))] = np.nan
+    k = np.flatnonzero(np.isfinite(rate).all(axis=1) & (True if rec.movement is None else rec.movement))
+    if len(k) < rec.fs:
+        return None
+    k = k[::-(-len(k) // LATENCY_SAMPLES)]
+    gyr, index = rec.gyr[k], np.arange(len(rate))
+
+    def mismatch(lag):  # gyro sample k against the reference's rate at k − lag (samples)
+        shifted = np.column_stack([np.interp(k - lag, index, rate[:, i]) for i in range(3)])
+        return float(np.nanmean(np.sum((gyr - shifted) ** 2, axis=1)))
+
+    lag = best_shift(mismatch, LATENCY_SEARCH_S * rec.fs)
+    return None if lag is None else lag / rec.fs
+
+
+def evaluate_recording(rec: Recording, method: str = "wiener", params=None, offline: bool = False,
+                       gyro_offset: bool = True, use_mag: bool = True, latency: float = 0.0) -> dict:
+    """{method label: {metric: value}} for one recording; with a magnetometer (and use_mag)
+    the method's heading comes from it, and vqf's 9D estimate is added as "vqf_9d".
+    latency (s): every estimate, the peers' too, is carried forward over the IMU's delay
+    (blocks.stages.timing; the peers' with the raw gyro)."""
+    rec.evaluated()  # refuses a recording without a usable reference before any work
+    import vqf as vqf_module  # peers: the test extra (or [peers])
+
+    label = f"{method}_offline" if offline else method
+    mag = rec.mag if use_mag else None
+    est = estimate(rec.gyr, rec.acc, rec.fs, method, params, offline=offline, gyro_offset=gyro_offset, mag=mag,
+                   latency=latency)
+    gyr, acc = np.ascontiguousarray(rec.gyr), np.ascontiguousarray(rec.acc)
+
+    def peer(quat):
+        quat = np.array(quat, dtype=float)
+        if latency:
+            carry_forward_rows(quat, np.zeros_like(gyr), gyr, latency)
+        return errors_on_movement(quat, rec)
+
+    table = {
+        label: errors_on_movement(est.quat, rec),
+        "vqf": peer(peer_quaternions("vqf", gyr, acc, rec.fs)),
+        "vqf_offline": peer(peer_quaternions("vqf_offline", gyr, acc, rec.fs)),
+        "madgwick": peer(peer_quaternions("madgwick", gyr, acc, rec.fs)),
+    }
+    if mag is not None:  # vqf's "no sample" is a zero row, where ours is NaN
+        mag = np.ascontiguousarray(np.where(np.isnan(mag).any(axis=1, keepdims=True), 0.0, mag))
+        table["vqf_9d"] = peer(vqf_module.VQF(1.0 / rec.fs).updateBatch(gyr, acc, mag)["quat9D"])
+    return table
+
+
+def evaluate(paths, method: str = "wiener", params=None, offline: bool = False, gyro_offset: bool = True,
+             use_mag: bool = True, progress: bool = True, start_in_movement: float | None = None,
+             read_options=None, latency: float = 0.0, gyr_samples: str = "mean", acc_samples: str = "point") -> dict:
+    """{"recordings": {name: {label: metrics}}, "mean": {label: metrics}, "imu_latency_s":
+    {name: seconds or None}} over the files (imu_latency: the IMU's delay behind the
+    reference, measured, whatever latency (s) the estimates were carried forward by);
+    gyr_samples "point": every recording's gyro is turned into interval means first
+    (blocks.stages.timing.interval_means), for the peers and the latency measured as well;
+    acc_samples "mean": every accelerometer mean is turned into the sensor frame at its
+    sample's time first (blocks.stages.timing.interval_ends), for the peers as well;
+    start_in_movement (s): cut each recording to begin that long into its movement phase;
+    read_options: keyword arguments of read_recording (units, fs, max_gap). Every file is
+    read and checked first. A recording's name is its file's stem, or its path where
+    stems repeat. progress also prints how each file was read where it matters (time
+    stamps, no movement flag)."""
+    check_options(method, params, offline, gyro_offset, use_mag, latency, gyr_samples, acc_samples)
+    read = []  # every file read and checked before any estimate: a bad last file costs nothing
+    for path in paths:
+        rec = read_recording(path, **(read_options or {}))
+        if gyr_samples == "point":
+            rec = replace(rec, gyr=interval_means(rec.gyr))
+        if acc_samples == "mean":
+            rec = replace(rec, acc=interval_ends(rec.gyr, rec.acc, 1.0 / rec.fs))
+        if start_in_movement is not None:
+            rec = rec.into_movement(start_in_movement)
+        rec.evaluated()
+        if progress:
+            print_notes(rec.notes + ([f"{rec.name}: no movement flag; errors over every sample with a reference"]
+                                     if rec.movement is None else []))
+        read.append((path, rec))
+    names = [rec.name for _, rec in read]
+    if len(set(names)) < len(names):  # files of one name from several folders: keyed by path
+        names = [str(path) for path, _ in read]
+    recordings, lags = {}, {}
+    for i, (name, (path, rec)) in enumerate(zip(names, read)):
+        if progress:
+            done = int(20 * i / len(paths))
+            print(f"\revaluate [{'#' * done}{'.' * (20 - done)}] {i + 1}/{len(paths)} {path}",
+                  end="" if sys.stderr.isatty() else "\n", file=sys.stderr, flush=True)
+        recordings[name] = evaluate_recording(rec, method, params, offline, gyro_offset, use_mag, latency)
+        lags[name] = imu_latency(rec)
+    if progress and sys.stderr.isatty():
+        print(file=sys.stderr)
+    found = [lag for lag in lags.values() if lag is not None]
+    if progress and found:
+        print(f"attitude: note: the IMU lags the reference by {1e3 * min(found):.2f} to {1e3 * max(found):.2f} ms "
+              f"(gyro against the reference's rate); --latency S carries every estimate forward by S seconds "
+              f"(now {latency:g})", file=sys.stderr)
+    labels = set.intersection(*(set(r) for r in recordings.values()))  # vqf_9d needs every file's mag
+    mean = {label: {m: float(np.mean([r[label][m] for r in recordings.values()])) for m in METRICS}
+            for label in next(iter(recordings.values())) if label in labels}
+    return {"recordings": recordings, "mean": mean, "imu_latency_s": lags}

@@ -1,0 +1,208 @@
+"""Building the project's FMUs (FMI 2.0 co-simulation) from fmu_src/ with pythonfmu.
+
+Each FMU carries in its resources the modules of attitude_fmu that its fmu_src adapter
+imports (carried_files), so it runs where only numpy, scipy, control and pythonfmu are
+installed, and carries no command line, plots, benchmarks or build code; its packages have
+no __init__.py there, so that FMUs of one build share them (fmu_support.foreign_code).
+
+On Linux (and macOS, not yet tried there) the FMU's binary is fmu_src/fmi2_guard.c,
+compiled here with the C compiler ($CC, else Python's, else cc); it loads pythonfmu's library from beside it and
+gives the FMI status codes their meaning (a logged error ends the call in fmi2Error); in an
+importer without Python it first starts the interpreter recorded by python_environment.
+Without a compiler the FMUs keep pythonfmu's binary, and a warning says what that costs.
+"""
+from __future__ import annotations
+
+import ast
+import hashlib
+import json
+import os
+import shlex
+import shutil
+import site
+import subprocess
+import sys
+import sysconfig
+import tempfile
+import zipfile
+from pathlib import Path
+
+import attitude_fmu
+from attitude_fmu.fmu_src.fmu_support import PACKAGE, code_digest
+
+FMU_NAMES = ("AttitudeEstimator", "ImuSensor", "MotionProfile")
+PACKAGE_DIR = Path(attitude_fmu.__file__).resolve().parent
+SOURCE_DIR = PACKAGE_DIR / "fmu_src"
+FINGERPRINT = "resources/attitude_fmu_sources.sha256"  # in the FMU: the sources it was built from
+PYTHON_ENVIRONMENT = "resources/python_environment.txt"  # in the FMU: see python_environment
+
+
+def _module_file(module: str) -> Path | None:
+    """The source file of an attitude_fmu module or package (dotted name), None if there is none."""
+    parts = module.split(".")[1:]
+    package = PACKAGE_DIR.joinpath(*parts, "__init__.py")
+    if package.is_file():
+        return package
+    return PACKAGE_DIR.joinpath(*parts).with_suffix(".py") if parts and PACKAGE_DIR.joinpath(*parts).with_suffix(".py").is_file() else None
+
+
+def _imports(path: Path, module: str) -> set[str]:
+    """The attitude_fmu modules the file of module imports anywhere in it (functions
+    included), except under `if TYPE_CHECKING:`; `from package import name` counts the
+    submodule name where there is one, else the package."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    skipped = {id(n) for node in ast.walk(tree) if isinstance(node, ast.If) and ast.unparse(node.test) == "TYPE_CHECKING"
+               for child in node.body for n in ast.walk(child)}
+    package = module if path.name == "__init__.py" else module.rpartition(".")[0]
+    found = set()
+    for node in ast.walk(tree):
+        if id(node) in skipped:
+            continue
+        if isinstance(node, ast.Import):
+            found.update(a.name for a in node.names if a.name.split(".")[0] == PACKAGE)
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                base = ".".join(package.split(".")[: len(package.split(".")) - node.level + 1] + ([base] if base else []))
+            if base.split(".")[0] != PACKAGE:
+                continue
+            for alias in node.names:
+                found.add(f"{base}.{alias.name}" if _module_file(f"{base}.{alias.name}") else base)
+    return found
+
+
+def carried_files(name: str) -> list[str]:
+    """Paths, relative to the package folder, of the modules the adapter fmu_src/<name>.py
+    (an FMU's top-level module) imports, directly or through others, with the __init__.py
+    of every package on the way."""
+    adapter = SOURCE_DIR / f"{name}.py"
+    todo, seen = sorted(_imports(adapter, name)), set()
+    while todo:
+        module = todo.pop()
+        parts = module.split(".")
+        for i in range(1, len(parts) + 1):  # a module's packages are imported with it
+            prefix = ".".join(parts[:i])
+            if prefix not in seen and _module_file(prefix) is not None:
+                seen.add(prefix)
+                todo.extend(_imports(_module_file(prefix), prefix))
+    return sorted(_module_file(m).relative_to(PACKAGE_DIR).as_posix() for m in seen)
+
+
+def source_fingerprint(name: str) -> str:
+    """SHA-256 over the sources an FMU is built from: its adapter, the modules it carries
+    (carried_files) and fmi2_guard.c."""
+    digest = hashlib.sha256(code_digest(PACKAGE_DIR, [f"fmu_src/{name}.py", *carried_files(name)]).encode())
+    digest.update((SOURCE_DIR / "fmi2_guard.c").read_bytes())
+    return digest.hexdigest()
+
+
+def python_environment() -> str:
+    """What fmi2_guard.c starts Python from in a host without it: the path of this
+    interpreter's shared libpython (empty where LIBDIR has none, e.g. a statically linked
+    interpreter whose distribution ships the library apart), its soname (looked up on the
+    library path), and the folders of this environment's packages as a list literal (put
+    first on sys.path)."""
+    soname = sysconfig.get_config_var("INSTSONAME") or ""
+    library = Path(sysconfig.get_config_var("LIBDIR") or "") / soname if soname else None
+    folders = [p for p in dict.fromkeys(site.getsitepackages() + [site.getusersitepackages()]) if Path(p).is_dir()]
+    return f"{library if library and library.is_file() else ''}\n{soname}\n{json.dumps(folders)}\n"
+
+
+def built_from(fmu) -> str | None:
+    """The source fingerprint stored in the FMU at its build; None if it has none."""
+    try:
+        with zipfile.ZipFile(fmu) as zf:
+            return zf.read(FINGERPRINT).decode().strip()
+    except (KeyError, OSError, zipfile.BadZipFile):
+        return None
+
+
+def build_fmus(out, names=FMU_NAMES) -> list[Path]:
+    """Build the named FMUs into the directory out; returns their paths."""
+    from pythonfmu.builder import FmuBuilder
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    built = []
+    with tempfile.TemporaryDirectory(prefix="attitude_fmu_") as tmp:
+        for name in names:
+            # only what the adapter imports, as namespace packages (fmu_support.foreign_code);
+            # no compiled files travel
+            staged = Path(tmp) / name / PACKAGE
+            for relative in (f for f in carried_files(name) if not f.endswith("__init__.py")):
+                (staged / relative).parent.mkdir(parents=True, exist_ok=True)
+                shutil.copy2(PACKAGE_DIR / relative, staged / relative)
+            built.append(Path(FmuBuilder.build_FMU(SOURCE_DIR / f"{name}.py", dest=out, project_files=[staged],
+                                                   needsExecutionTool="false", canGetAndSetFMUstate="true",
+                                                   canSerializeFMUstate="true")))
+        guard = compile_guard(Path(tmp) / "fmi2_guard.so")
+        for path in built:
+            if guard is not None:
+                install_guard(path, guard)
+            with zipfile.ZipFile(path, "a", zipfile.ZIP_DEFLATED) as zf:
+                zf.writestr(FINGERPRINT, source_fingerprint(path.stem) + "\n")
+                zf.writestr(PYTHON_ENVIRONMENT, python_environment())
+    return built
+
+
+GUARD_PLATFORMS = {"linux": "linux64", "darwin": "darwin64"}  # sys.platform prefix → FMI binaries folder
+PYTHONFMU_LIBRARY = "pythonfmu-export.so"  # the name fmi2_guard.c loads
+
+
+def guard_platform() -> str | None:
+    """The FMI binaries folder the guard is built for on this machine; None: no guard here."""
+    return next((v for k, v in GUARD_PLATFORMS.items() if sys.platform.startswith(k)), None)
+
+
+def compile_guard(out: Path, log=lambda m: print(m, file=sys.stderr)) -> Path | None:
+    """Compile fmi2_guard.c into the shared library out; None (with a warning) where it cannot be."""
+    platform = guard_platform()
+    cc = shlex.split(os.environ.get("CC") or sysconfig.get_config_var("CC") or "cc")
+    command = [*cc, "-shared", "-fPIC", "-O2", "-fvisibility=hidden", "-o", str(out),
+               str(SOURCE_DIR / "fmi2_guard.c"), "-ldl", "-lpthread"]
+    consequence = ("the FMUs keep pythonfmu's own binary: an invalid parameter ends in fmi2Discard "
+                   "instead of fmi2Error, and log messages need debug logging on")
+    if platform is None:
+        log(f"warning: no FMI guard for platform {sys.platform}; {consequence}")
+        return None
+    try:
+        subprocess.run(command, check=True, capture_output=True, text=True)
+    except (OSError, subprocess.CalledProcessError) as exc:
+        detail = getattr(exc, "stderr", None) or exc
+        log(f"warning: cannot compile fmi2_guard.c ({shlex.join(command)}: {detail}); {consequence}")
+        return None
+    return out
+
+
+def install_guard(fmu: Path, guard: Path) -> None:
+    """Make guard the FMU's binary for this platform, pythonfmu's library its PYTHONFMU_LIBRARY."""
+    platform = guard_platform()
+    suffix = ".dylib" if platform == "darwin64" else ".so"
+    binary = f"binaries/{platform}/{fmu.stem}{suffix}"
+    staged = fmu.with_suffix(".guarded")
+    with zipfile.ZipFile(fmu) as src, zipfile.ZipFile(staged, "w", zipfile.ZIP_DEFLATED) as dst:
+        if binary not in src.namelist():
+            raise RuntimeError(f"{fmu} has no {binary} to guard")
+        for item in src.infolist():
+            name = item.filename
+            if name == binary:
+                name = f"binaries/{platform}/{PYTHONFMU_LIBRARY}"
+                dst.write(guard, binary)
+            dst.writestr(name if name != item.filename else item, src.read(item))
+    staged.replace(fmu)
+
+
+def ensure_built(fmu_dir, rebuild: bool = False, log=print) -> Path:
+    """The directory holding every FMU, building those missing or built from other sources
+    than this installation's (or all with rebuild): FMUs loaded into one process share the
+    first-loaded copy of the project's modules, so the ones run must match the code."""
+    fmu_dir = Path(fmu_dir)
+    missing = [n for n in FMU_NAMES if rebuild or not (fmu_dir / f"{n}.fmu").is_file()]
+    stale = [n for n in FMU_NAMES if n not in missing and built_from(fmu_dir / f"{n}.fmu") != source_fingerprint(n)]
+    if missing:
+        log(f"building {', '.join(missing)} into {fmu_dir}")
+    if stale:
+        log(f"rebuilding {', '.join(stale)} in {fmu_dir}: built from other sources than these")
+    if missing or stale:
+        build_fmus(fmu_dir, [n for n in FMU_NAMES if n in missing or n in stale])
+    return fmu_dir

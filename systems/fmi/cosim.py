@@ -1,0 +1,262 @@
+"""A small co-simulation master for the project's SSP files, on fmpy's FMU2Slave API.
+
+fmpy.ssp.simulate_ssp falls short here in three ways: it ignores the parameter bindings
+inside the SSD (it takes one parameter set as an argument), it cannot set String
+variables (the estimator's `method`, the motion's `profile`), and it passes values along
+connections only after every component has stepped, so each connection delays by one
+step and every connector starts at 0. This master reads the same SSD with fmpy, applies
+its inline parameter values of every type, and steps the components in the order of
+their connections (Gauss–Seidel): in doStep(t, h) the estimator receives the sensor
+samples of (t, t+h], exactly as the batch path consumes them. cosimulate_libcosim runs
+the same SSP in a second importer, independent of fmpy (libcosim).
+"""
+from __future__ import annotations
+
+import shutil
+from collections import defaultdict
+from pathlib import Path
+
+import numpy as np
+from fmpy import extract, read_model_description
+from fmpy.fmi1 import FMICallException
+from fmpy.fmi2 import FMU2Slave
+from fmpy.ssp.ssd import read_ssd
+
+_loaded = False  # whether this process has loaded an FMU's library
+
+
+def load_slave(md, unzipdir, instance_name: str) -> FMU2Slave:
+    """An FMU2Slave for an extracted FMU (pythonfmu FMUs: see fmus_loaded)."""
+    global _loaded
+    _loaded = True
+    return FMU2Slave(guid=md.guid, unzipDirectory=unzipdir, modelIdentifier=md.coSimulation.modelIdentifier,
+                     instanceName=instance_name)
+
+
+def fmus_loaded() -> bool:
+    """Whether this process loaded an FMU. pythonfmu's export library finalises its Python
+    state from a library destructor, which can crash at interpreter shutdown after all
+    work is done; processes that loaded FMUs end with os._exit once they have reported."""
+    return _loaded
+
+
+class _Component:
+    """One instantiated FMU of the SSD with its variable references."""
+
+    def __init__(self, element, ssp_dir: Path):
+        fmu_path = ssp_dir / element.source
+        self.name = element.name
+        self.md = read_model_description(fmu_path)
+        self.variables = {v.name: v for v in self.md.modelVariables}
+        self.unzipdir = extract(fmu_path)
+        self.fmu = load_slave(self.md, self.unzipdir, element.name)
+        self.outputs = [v.name for v in self.md.modelVariables if v.causality == "output"]
+        self.real_out = [n for n in self.outputs if self.variables[n].type == "Real"]
+        self.bool_out = [n for n in self.outputs if self.variables[n].type == "Boolean"]
+        self.real_out_vr = [self.variables[n].valueReference for n in self.real_out]
+        self.bool_out_vr = [self.variables[n].valueReference for n in self.bool_out]
+        self.inputs: list[tuple[str, str, str]] = []  # (own input, source component, source output)
+
+    def start(self, parameters, start_time: float):
+        self.fmu.instantiate()
+        self.fmu.setupExperiment(startTime=start_time)
+        self.fmu.enterInitializationMode()
+        for p in parameters:
+            vr = [self.variables[p.name].valueReference]
+            if p.type == "Real":
+                self.fmu.setReal(vr, [float(p.value)])
+            elif p.type == "Integer":
+                self.fmu.setInteger(vr, [int(p.value)])
+            elif p.type == "Boolean":
+                self.fmu.setBoolean(vr, [p.value.lower() == "true"])
+            else:
+                self.fmu.setString(vr, [p.value])
+        self.fmu.exitInitializationMode()
+        self.input_vr = [self.variables[name].valueReference for name, _, _ in self.inputs]
+
+    def stop(self):
+        self.fmu.terminate()
+        self.fmu.freeInstance()
+        shutil.rmtree(self.unzipdir, ignore_errors=True)
+
+
+def cosimulate(ssp_path, stop_time: float, step_size: float, progress=None) -> dict[str, np.ndarray]:
+    """Run the SSP from 0 to stop_time (s) with a fixed step (s).
+
+    Returns "time" (end of each step) and every output as "component.variable", one
+    value per step. progress(fraction) is called about every 1 % when given.
+    """
+    ssd = read_ssd(str(ssp_path))
+    ssp_dir = Path(extract(str(ssp_path)))
+    components = {}
+    try:
+        for element in ssd.system.elements:
+            components[element.name] = _Component(element, ssp_dir)
+        for c in ssd.system.connections:
+            components[c.endElement].inputs.append((c.endConnector, c.startElement, c.startConnector))
+        order = _stepping_order(components)
+        for element in ssd.system.elements:
+            params = [p for b in element.parameterBindings for s in b.parameterValues for p in s.parameters]
+            try:
+                components[element.name].start(params, 0.0)
+            except FMICallException as exc:
+                raise RuntimeError(f"component {element.name} failed to initialise: {exc}") from None
+        n = int(round(stop_time / step_size))
+        record = {f"{c.name}.{v}": np.empty(n, dtype=bool if v in c.bool_out else float)
+                  for c in components.values() for v in c.outputs}
+        latest = {c.name: {} for c in components.values()}
+        for k in range(n):
+            t = k * step_size
+            for comp in order:
+                if comp.inputs:
+                    comp.fmu.setReal(comp.input_vr, [latest[src][out] for _, src, out in comp.inputs])
+                try:
+                    comp.fmu.doStep(currentCommunicationPoint=t, communicationStepSize=step_size)
+                except FMICallException as exc:
+                    raise RuntimeError(f"component {comp.name} failed at t = {t:g} s: {exc}") from None
+                values = dict(zip(comp.real_out, comp.fmu.getReal(comp.real_out_vr)))
+                if comp.bool_out_vr:
+                    values.update(zip(comp.bool_out, comp.fmu.getBoolean(comp.bool_out_vr)))
+                latest[comp.name] = values
+                for name, value in values.items():
+                    record[f"{comp.name}.{name}"][k] = value
+            if progress is not None and k % max(1, n // 100) == 0:
+                progress(k / n)
+        record["time"] = (np.arange(n) + 1) * step_size
+        return record
+    finally:
+        for comp in components.values():
+            try:
+                comp.stop()
+            except Exception:  # an instance that never started has nothing to free
+                shutil.rmtree(comp.unzipdir, ignore_errors=True)
+        shutil.rmtree(ssp_dir, ignore_errors=True)
+
+
+def cosimulate_libcosim(ssp_path, stop_time: float, step_size: float, progress=None) -> dict[str, np.ndarray]:
+    """Run the SSP with libcosim (Open Simulation Platform; libcosimpy, CPython >= 3.11):
+    an importer independent of fmpy, with its own SSP reader, FMI Library, and a
+    fixed-step master in which each connection delays by one step and inputs begin at
+    their start values. Returns, as cosimulate does, "time" and every input and output as
+    "component.variable", one value per step (time kept in integer nanoseconds)."""
+    try:
+        from libcosimpy.CosimEnums import CosimVariableCausality as Causality
+        from libcosimpy.CosimEnums import CosimVariableType as Type
+        from libcosimpy.CosimExecution import CosimExecution
+        from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+        from libcosimpy.CosimObserver import CosimObserver
+    except ImportError:
+        raise RuntimeError("the libcosim master needs libcosimpy: pip install libcosimpy (CPython >= 3.11)") from None
+    log_output_level(CosimLogLevel.WARNING)
+    global _loaded
+    _loaded = True
+    try:
+        ex = CosimExecution.from_ssp_file(str(ssp_path), int(round(step_size * 1e9)))
+    except AssertionError:
+        raise RuntimeError(f"libcosim cannot load {ssp_path} (its log above says why)") from None
+    observer = CosimObserver.create_last_value()
+    ex.add_observer(observer)
+    reads = []  # (component index, reader, references, record names, dtype)
+    for slave in ex.slave_infos():
+        variables = [v for v in ex.slave_variables(slave.index)
+                     if v.causality in (Causality.INPUT.value, Causality.OUTPUT.value)]
+        for kind, reader, dtype in ((Type.REAL, observer.last_real_values, float),
+                                    (Type.BOOLEAN, observer.last_boolean_values, bool)):
+            chosen = [v for v in variables if v.type == kind.value]
+            if chosen:
+                reads.append((slave.index, reader, [v.reference for v in chosen],
+                              [f"{slave.name.decode()}.{v.name.decode()}" for v in chosen], dtype))
+    n = int(round(stop_time / step_size))
+    record = {name: np.empty(n, dtype=dtype) for *_, names, dtype in reads for name in names}
+    for k in range(n):
+        if not ex.step():
+            raise RuntimeError(f"libcosim failed at t = {k * step_size:g} s (its log above says why)")
+        for index, reader, references, names, _ in reads:
+            for name, value in zip(names, reader(index, references)):
+                record[name][k] = value
+        if progress is not None and k % max(1, n // 100) == 0:
+            progress(k / n)
+    record["time"] = (np.arange(n) + 1) * step_size
+    return record
+
+
+def _stepping_order(components: dict) -> list:
+    """Components sorted so that every one steps after the components feeding it."""
+    feeds = defaultdict(set)
+    for comp in components.values():
+        for _, src, _ in comp.inputs:
+            feeds[comp.name].add(src)
+    order, done = [], set()
+    while len(order) < len(components):
+        ready = [c for c in components.values() if c.name not in done and feeds[c.name] <= done]
+        if not ready:
+            raise ValueError("the SSP's connections form a loop; this master steps acyclic diagrams only")
+        for comp in ready:
+            order.append(comp)
+            done.add(comp.name)
+    return order
+
+
+class FmuRunner:
+    """One FMU driven step by step with fmpy: parameters at initialisation, then
+    step(inputs) → outputs. reset() restarts it with the same parameters (fmi2Reset)."""
+
+    def __init__(self, fmu_path, parameters: dict | None = None, inputs=(), outputs=(), logging: bool = False):
+        self.md = read_model_description(str(fmu_path))
+        self.variables = {v.name: v for v in self.md.modelVariables}
+        self.unzipdir = extract(str(fmu_path))
+        self.fmu = load_slave(self.md, self.unzipdir, Path(fmu_path).stem)
+        self.parameters = dict(parameters or {})
+        self.input_vr = [self.variables[n].valueReference for n in inputs]
+        self.output_vr = [self.variables[n].valueReference for n in outputs]
+        self.valid_vr = [self.variables["valid"].valueReference] if "valid" in self.variables else []
+        self.time = 0.0
+        self.fmu.instantiate(loggingOn=logging)
+        try:
+            self._initialise()
+        except FMICallException:  # fmi2Error: the instance may only be freed
+            self.fmu.freeInstance()
+            shutil.rmtree(self.unzipdir, ignore_errors=True)
+            raise
+
+    def _initialise(self):
+        self.fmu.setupExperiment(startTime=0.0)
+        self.fmu.enterInitializationMode()
+        for name, value in self.parameters.items():
+            vr = [self.variables[name].valueReference]
+            kind = self.variables[name].type
+            if kind == "String":
+                self.fmu.setString(vr, [value])
+            elif kind == "Integer":
+                self.fmu.setInteger(vr, [int(value)])
+            elif kind == "Boolean":
+                self.fmu.setBoolean(vr, [bool(value)])
+            else:
+                self.fmu.setReal(vr, [float(value)])
+        self.fmu.exitInitializationMode()
+        self.time = 0.0
+
+    def step(self, inputs, h: float):
+        """Set inputs, doStep(time, h), return (outputs, valid or None)."""
+        self.fmu.setReal(self.input_vr, [float(v) for v in inputs])
+        self.fmu.doStep(currentCommunicationPoint=self.time, communicationStepSize=h)
+        self.time += h
+        valid = bool(self.fmu.getBoolean(self.valid_vr)[0]) if self.valid_vr else None
+        return np.array(self.fmu.getReal(self.output_vr)), valid
+
+    def run(self, inputs: np.ndarray, h: float):
+        """Step through the rows of inputs (N×len(inputs)); outputs N×len(outputs), valid N."""
+        out = np.empty((len(inputs), len(self.output_vr)))
+        valid = np.empty(len(inputs), dtype=bool)
+        for k, row in enumerate(inputs):
+            out[k], valid[k] = self.step(row, h)
+        return out, valid
+
+    def reset(self):
+        self.fmu.reset()
+        self._initialise()
+
+    def close(self):
+        self.fmu.terminate()
+        self.fmu.freeInstance()
+        shutil.rmtree(self.unzipdir, ignore_errors=True)

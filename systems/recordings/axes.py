@@ -1,0 +1,164 @@
+"""Axis conventions of a recording: signed axis maps (--gyr-axes, --acc-axes, --mag-axes)
+and a check that the accelerometer and the magnetometer turn as the gyro says they do.
+
+A map such as "y,x,-z" gives each axis of the recording's frame (x, y, z in turn: the frame
+of the estimate and of a reference) as a signed axis of one sensor's columns: x is the
+file's y, y its x and z its −z (the magnetometer of the MPU-9250 sits so to its gyro and
+accelerometer). Maps may be reflections: a left-handed sensor becomes right-handed.
+
+The check: gravity and the earth's field are fixed in the earth, so in the frame integrated
+from the gyro (blocks.quaternion.integrate_rates) a sensor's vector stays put, up to the
+motion's acceleration and, for the magnetometer, a hard-iron offset h fixed to the sensor
+(fitted per map). Means over windows of WINDOW_S seconds take most of the acceleration out
+(a window's mean is its change of velocity over WINDOW_S), and the change of the mean from
+one window to the next, where the sensor turned by at least MIN_TURN_RAD between them,
+scores a map: the mean square of that change. Every signed map of the vector is scored,
+with the gyro as it is and reversed (a clockwise-positive gyro); a map that fits
+MISMATCH_RATIO times better than the recording as given and than any other is named with
+the flags that apply it, and nothing is said where the given axes' mismatch is below
+SIGNIFICANT of the vector's mean square (the few degrees gyro drift and motion make).
+"""
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from attitude_fmu.blocks.quaternion import integrate_rates
+
+AXES = "xyz"
+WINDOW_S = 2.0  # s over which a measured vector is averaged (in the gyro's frame) before comparing
+CHUNK_ROWS = 100_000  # samples whose frame matrices are held at once
+MIN_TURN_RAD = 0.3  # windows turning less than this from one to the next tell the maps too little apart
+MIN_WINDOWS = 20  # fewer turning pairs of windows than this: no verdict
+MISMATCH_RATIO = 4.0  # how much better a map must fit to be named
+SIGNIFICANT = 0.01  # nor is a mismatch below this share of the vector's mean square (≈ 6° of direction: drift's)
+
+
+def parse_axes(text: str) -> np.ndarray:
+    """The 3×3 signed permutation of a map "a,b,c" (each a signed x, y or z, every letter
+    once): row i takes the file's axis named in place i."""
+    parts = [p.strip().lower() for p in str(text).split(",")]
+    letters = [p.lstrip("+-") for p in parts]
+    if len(parts) != 3 or sorted(letters) != list(AXES) or any(len(p) - len(l) > 1 for p, l in zip(parts, letters)):
+        raise ValueError(f"an axis map names x, y and z once each, signed, as x,y,z or y,x,-z; got {text!r}")
+    matrix = np.zeros((3, 3))
+    for row, (part, letter) in enumerate(zip(parts, letters)):
+        matrix[row, AXES.index(letter)] = -1.0 if part.startswith("-") else 1.0
+    return matrix
+
+
+def axes_text(matrix) -> str:
+    """The map "a,b,c" of a signed permutation (parse_axes' inverse)."""
+    return ",".join(f"{'-' if row[np.argmax(np.abs(row))] < 0 else ''}{AXES[np.argmax(np.abs(row))]}"
+                    for row in np.asarray(matrix))
+
+
+MAPS = [np.diag(signs)[list(order)] for order in itertools.permutations(range(3))
+        for signs in itertools.product((1.0, -1.0), repeat=3) if sum(signs) >= 1]
+# the 24 signed permutations with at most one axis reversed, identity first: −P turns a
+# vector as P does, so of each pair the one that changes fewer signs stands for both
+
+
+def _orientations(gyr, fs: float) -> Rotation:
+    """The frame after each gyro sample (rad/s, mean rates) in the frame before the first."""
+    quat = np.empty((len(gyr), 4))
+    integrate_rates(np.ascontiguousarray(gyr, dtype=float), 1.0 / fs, quat)
+    return Rotation.from_quat(quat, scalar_first=True)
+
+
+def _window(fs: float) -> int:
+    """Samples in a window of WINDOW_S seconds at fs (Hz)."""
+    return max(1, int(round(WINDOW_S * fs)))
+
+
+def _window_means(frames: Rotation, vectors, finite, window: int):
+    """Per window of `window` samples, over its finite rows: the mean frame matrix Q (B×3×3)
+    and the means of Q_ki·v_j (B×3×3×3), a map P's mean in the gyro frame being
+    Σ_ij P_ij·(these)_kij; in chunks of about CHUNK_ROWS samples."""
+    blocks = len(finite) // window
+    count = np.maximum(finite.reshape(blocks, window).sum(axis=1), 1)
+    mean_frame, products = np.empty((blocks, 3, 3)), np.empty((blocks, 3, 3, 3))
+    step = max(1, CHUNK_ROWS // window)
+    for start in range(0, blocks, step):
+        b = slice(start, min(blocks, start + step))
+        rows = slice(b.start * window, b.stop * window)
+        used = finite[rows].reshape(-1, window)[:, :, None]
+        q = frames[rows].as_matrix().reshape(-1, window, 3, 3) * used[..., None]
+        mean_frame[b] = q.sum(axis=1) / count[b, None, None]
+        v = vectors[rows].reshape(-1, window, 3) * used
+        products[b] = np.einsum("bwki,bwj->bkij", q, v) / count[b, None, None, None]
+    return mean_frame, products
+
+
+def mismatches(frames: dict, vectors, fs: float, hard_iron: bool = False) -> dict | None:
+    """{(map index in MAPS, gyro reversed): mean-square mismatch} (units² of vectors) of
+    every map of vectors (N×3; rows with a NaN are not used), in frames ({gyro reversed:
+    the N frames _orientations integrates from the gyro, or from its negative}): the gyro
+    as it is and, unless hard_iron (the magnetometer: its offset is fitted per map),
+    reversed; None where fewer than MIN_WINDOWS pairs of windows turn enough."""
+    window = _window(fs)
+    blocks = len(vectors) // window
+    if blocks < MIN_WINDOWS:
+        return None
+    n = blocks * window
+    finite = np.isfinite(vectors[:n]).all(axis=1)
+    vectors = np.where(finite[:, None], vectors[:n], 0.0)
+    sampled = finite.reshape(blocks, window).any(axis=1)
+    scores = {}
+    for reversed_gyro in (False, True) if not hard_iron else (False,):
+        turned = frames[reversed_gyro][:n]
+        centres = turned[window // 2::window]
+        turn = (centres[:-1].inv() * centres[1:]).magnitude()
+        pairs = np.flatnonzero((turn >= MIN_TURN_RAD) & sampled[:-1] & sampled[1:])
+        if len(pairs) < MIN_WINDOWS:
+            return None
+        mean_frame, products = _window_means(turned, vectors, finite, window)
+        lever = -(mean_frame[pairs + 1] - mean_frame[pairs])  # −Δ mean(Q)·h: the hard iron's part
+        for index, matrix in enumerate(MAPS):
+            means = np.einsum("bkij,ij->bk", products, matrix)
+            residual = means[pairs + 1] - means[pairs]
+            if hard_iron:
+                h = np.linalg.lstsq(lever.reshape(-1, 3), residual.reshape(-1), rcond=None)[0]
+                residual = residual - lever @ h
+            scores[(index, reversed_gyro)] = float(np.mean(np.sum(residual**2, axis=1)))
+    return scores
+
+
+def axes_note(name: str, what: str, flag: str, unit: str, scores: dict | None, mean_square: float) -> str | None:
+    """A note naming the flags that make `what` (measured in unit, of mean_square (unit)²)
+    turn as the gyro says, where one map fits MISMATCH_RATIO times better than the
+    recording as given and than any other; a vaguer one where the given axes fit that
+    much worse than several maps. Nothing where the given mismatch is below SIGNIFICANT
+    of mean_square."""
+    if scores is None:
+        return None
+    ranked = sorted(scores, key=scores.get)
+    best, runner_up, given = scores[ranked[0]], scores[ranked[1]], scores[(0, False)]
+    if ranked[0] == (0, False) or given < max(MISMATCH_RATIO * best, SIGNIFICANT * mean_square):
+        return None
+    head = (f"{name}: {what} does not turn as the gyro says (mean-square change of its {WINDOW_S:g}-s means "
+            f"in the gyro's frame {given:.3g} ({unit})²")
+    if runner_up < MISMATCH_RATIO * best:
+        return (f"{head}, {best:.3g} with other axes, which this motion does not single out); "
+                f"check {flag} and --gyr-axes")
+    index, reversed_gyro = ranked[0]
+    flags = " ".join(([f"{flag}={axes_text(MAPS[index])}"] if index else [])
+                     + (["--gyr-axes=-x,-y,-z"] if reversed_gyro else []))  # "=": a map may begin with "-"
+    negative = (f"; {flag}={axes_text(-MAPS[index])}, the same with the sign of {what} reversed, fits as well"
+                if index else "")
+    return f"{head}); with {flags} it is {best:.3g}: pass that if the file's axes are so{negative}"
+
+
+def axes_notes(name: str, gyr, acc, mag, fs: float) -> list[str]:
+    """The notes of axes_note on a recording's accelerometer and magnetometer (or None)."""
+    if len(gyr) // _window(fs) < MIN_WINDOWS:  # too short for a verdict (mismatches): nothing integrated
+        return []
+    frames = {False: _orientations(gyr, fs), True: _orientations(-gyr, fs)}  # one integration each, for both sensors
+    mean_square = lambda v: float(np.nanmean(np.sum(v**2, axis=1)))
+    notes = [axes_note(name, "the accelerometer", "--acc-axes", "m/s²", mismatches(frames, acc, fs), mean_square(acc))]
+    if mag is not None:
+        notes.append(axes_note(name, "the magnetometer", "--mag-axes", "µT",
+                               mismatches(frames, mag, fs, hard_iron=True), mean_square(mag)))
+    return [note for note in notes if note]

@@ -1,0 +1,364 @@
+"""Reading IMU recordings (CSV or BROAD .mat) into a Recording: units, columns, time stamps
+and gaps, axes; the checks of systems.recordings.checks."""
+from __future__ import annotations
+
+import csv
+import itertools
+import math
+import re
+import shlex
+import warnings
+from collections.abc import Mapping
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from attitude_fmu.systems.recordings.axes import axes_notes, parse_axes
+from attitude_fmu.systems.recordings.checks import (
+    check_rate,
+    check_shapes,
+    check_values,
+    fill_non_finite,
+    saturation_notes,
+)
+from attitude_fmu.systems.recordings.recording import (
+    ACC_UNITS,
+    GYR_UNITS,
+    IMU_COLUMNS,
+    KNOWN_COLUMNS,
+    MAG_COLUMNS,
+    MAG_UNITS,
+    MAT_VARIABLES,
+    MOVEMENT_COLUMN,
+    REF_COLUMNS,
+    T_UNITS,
+    Recording,
+    RecordingError,
+)
+
+DELIMITERS = (",", ";", "\t")  # the header's most frequent one; with ";" or a tab, "," is a decimal comma
+MAX_GAP_S = 1.0  # longest run of missing samples filled in by default (s)
+MAX_LABEL_ROWS = 3  # rows without a number after the header that are skipped (units); more: refused
+JITTER_NOTE = 0.1  # time stamps off the uniform grid by more than this share of a step are noted
+
+
+def read_recording(path, fs: float | None = None, gyr_unit: str = "rad/s", acc_unit: str = "m/s2",
+                   mag_unit: str = "uT", max_gap: float = MAX_GAP_S, t_unit: str = "s",
+                   columns: Mapping[str, str] | None = None, gyr_axes: str | None = None,
+                   acc_axes: str | None = None, mag_axes: str | None = None) -> Recording:
+    """Read a CSV (header t,gyr_x..z,acc_x..z[,mag_x..z][,ref_q_w..z][,movement]; t may be
+    replaced by fs) or a BROAD .mat, in the units given (GYR_UNITS, ACC_UNITS, MAG_UNITS,
+    T_UNITS), into rad/s, m/s², µT and s (values no IMU gives: check_values). columns
+    ({our name: the CSV's}) reads a header
+    with other names (a logger's export) without editing the file. gyr_axes, acc_axes,
+    mag_axes: signed axis maps into the output's frame (systems.recordings.axes.parse_axes); an
+    accelerometer or magnetometer that does not turn as the gyro says is noted
+    (systems.recordings.axes.axes_notes). A CSV's time stamps may jitter and skip samples:
+    runs of missing samples up to max_gap seconds are filled in (_fill_gaps), longer ones
+    refused; so are runs of gyro or accelerometer values that are not finite
+    (fill_non_finite)."""
+    path = Path(path)
+    if not path.is_file():
+        raise RecordingError(f"{path}: no such file")
+    units = ((gyr_unit, GYR_UNITS), (acc_unit, ACC_UNITS), (mag_unit, MAG_UNITS), (t_unit, T_UNITS))
+    if any(unit not in known for unit, known in units):
+        raise RecordingError(f"units must be one of {', '.join(str(list(known)) for _, known in units)}")
+    if fs is not None and not (math.isfinite(fs) and fs > 0):
+        raise RecordingError(f"the sample rate must be a finite positive number of Hz, got {fs!r}")
+    if not (math.isfinite(max_gap) and max_gap >= 0):
+        raise RecordingError(f"the longest gap to fill must be a finite number of seconds ≥ 0, got {max_gap!r}")
+    maps = {name: parse_axes(text) for name, text in (("gyr", gyr_axes), ("acc", acc_axes), ("mag", mag_axes))
+            if text is not None}
+    columns = dict(columns or {})
+    mat = path.suffix.lower() == ".mat"
+    known = MAT_VARIABLES if mat else KNOWN_COLUMNS
+    unknown = [name for name in columns if name not in known]
+    if unknown:
+        raise RecordingError(f"--column names {', '.join(unknown)}; a {'.mat' if mat else 'CSV'}'s names read are "
+                             f"{', '.join(known)}")
+    shared = sorted({c for c in columns.values() if list(columns.values()).count(c) > 1})
+    if shared:
+        raise RecordingError(f"--column gives the file's column {', '.join(shared)} more than one name")
+    rec = _read_mat(path, fs, columns) if mat else _read_csv(path, fs, max_gap, T_UNITS[t_unit], columns)
+    if fs is not None and abs(rec.fs - fs) > 0.01 * fs:
+        raise RecordingError(f"{path}: --fs {fs:g} Hz disagrees with the recording's {rec.fs:g} Hz")
+    rec.gyr = rec.gyr * GYR_UNITS[gyr_unit]
+    rec.acc = rec.acc * ACC_UNITS[acc_unit]
+    if rec.mag is not None and np.isnan(rec.mag).any(axis=1).all():
+        rec.mag = None
+        rec.notes.append(f"{rec.name}: the magnetometer has no sample (NaN throughout); heading from the gyro")
+    if rec.mag is not None:
+        rec.mag = rec.mag * MAG_UNITS[mag_unit]
+    check_shapes(rec)
+    check_rate(rec.name, rec.fs)
+    fill_non_finite(rec, max_gap)
+    check_values(rec, gyr_unit, acc_unit)
+    rec.notes += saturation_notes(rec)
+    for name, matrix in maps.items():
+        if getattr(rec, name) is not None:
+            setattr(rec, name, getattr(rec, name) @ matrix.T)
+    rec.notes += axes_notes(rec.name, rec.gyr, rec.acc, rec.mag, rec.fs)
+    return rec
+
+
+def _read_csv(path: Path, fs: float | None, max_gap: float, t_scale: float, columns: dict) -> Recording:
+    with path.open(newline="", encoding="utf-8-sig") as fh:  # a spreadsheet's byte-order mark is not a name
+        first = fh.readline()
+        following = list(itertools.islice(fh, MAX_LABEL_ROWS + 1))
+    delimiter = max(DELIMITERS, key=first.count)
+    header = next(csv.reader([first], delimiter=delimiter), None)
+    if not header:
+        raise RecordingError(f"{path}: empty file; expected a header t,{','.join(IMU_COLUMNS)}")
+    header = [h.strip() for h in header]
+    header[0] = header[0].lstrip("#").strip()  # a header marked as a comment (numpy.savetxt's default)
+    header = _renamed(path, header, columns)
+    missing = [c for c in IMU_COLUMNS if c not in header]
+    if missing:
+        raise RecordingError(f"{path}: missing columns {', '.join(missing)} (header: {','.join(header)})"
+                             f"{_column_hint(missing, header)}")
+    for group, what in ((MAG_COLUMNS, "the magnetometer"), (REF_COLUMNS, "the reference")):
+        given = [c for c in group if c in header]
+        if given and len(given) < len(group):
+            raise RecordingError(f"{path}: {what} needs all of {','.join(group)}, "
+                                 f"the header has only {','.join(given)}")
+    if "t" not in header and fs is None:
+        raise RecordingError(f"{path}: no 't' column; give the sample rate with --fs HZ{_column_hint(['t'], header)}")
+    labels = _label_rows(following, delimiter)
+    try:
+        with warnings.catch_warnings():  # no rows: said below, not as numpy's warning
+            warnings.simplefilter("ignore", UserWarning)
+            with path.open(encoding="utf-8-sig") as fh:
+                rows = fh if delimiter == "," else (_decimal_points(line, delimiter) for line in fh)
+                data = np.loadtxt(rows, delimiter=delimiter, skiprows=1 + len(labels), ndmin=2, dtype=float)
+    except ValueError:
+        raise RecordingError(f"{path}: {_first_bad_line(path, delimiter, header, 1 + len(labels))}") from None
+    if data.shape[0] == 0 or data.shape[1] != len(header):
+        raise RecordingError(f"{path}: expected {len(header)} columns of numbers and at least one row")
+    col = {name: data[:, i] for i, name in enumerate(header)}
+    columns = lambda names: np.column_stack([col[c] for c in names]) if all(c in col for c in names) else None
+    movement = col.get(MOVEMENT_COLUMN)
+    rec = Recording(path.stem, 0.0, columns(IMU_COLUMNS[:3]), columns(IMU_COLUMNS[3:]),
+                    None if "t" not in col else col["t"] * t_scale,
+                    columns(MAG_COLUMNS), columns(REF_COLUMNS),
+                    None if movement is None else _flag(path, MOVEMENT_COLUMN, movement))
+    if labels:
+        rec.notes.append(f"{rec.name}: {len(labels)} row{'s' * (len(labels) > 1)} after the header without a number "
+                         f"skipped (units?): {' / '.join(labels)}")
+    unknown = [c for c in header if c not in KNOWN_COLUMNS]
+    if unknown:
+        absent = [c for c in KNOWN_COLUMNS if c not in header]
+        rec.notes.append(f"{rec.name}: columns not read: {', '.join(unknown)}{_column_hint(absent, unknown)}")
+    if rec.t is None:
+        rec.fs, rec.t = float(fs), np.arange(1, data.shape[0] + 1) / fs
+        return rec
+    if not np.isfinite(rec.t).all():
+        raise RecordingError(f"{path}: column t has non-finite values")
+    if len(rec.t) == 1 and fs is not None:  # one time stamp gives no rate; --fs does
+        rec.fs = float(fs)
+        return rec
+    index, rec.fs, off_grid = _sample_grid(path, rec.t, max_gap)
+    if off_grid > JITTER_NOTE:
+        rec.notes.append(f"{rec.name}: time stamps up to {off_grid:.0%} of a step off a uniform grid; "
+                         f"the samples are taken as uniform at {rec.fs:.6g} Hz")
+    if index[-1] + 1 > len(index):
+        rec = _fill_gaps(rec, index)
+    return rec
+
+
+def _decimal_points(line: str, delimiter: str) -> str:
+    """line with its decimal commas as points, where the separator is not the comma."""
+    return line if delimiter == "," else line.replace(",", ".")
+
+
+def _label_rows(lines, delimiter: str) -> list[str]:
+    """Of the lines right after the header, the first ones (at most MAX_LABEL_ROWS) in
+    which no field is a number: a units row ("s,rad/s,…") or a second header line, as
+    loggers write them."""
+    labels = []
+    for line in lines:
+        fields = _decimal_points(line, delimiter).strip().split(delimiter)
+        if not line.strip() or any(_is_number(f) for f in fields):
+            break
+        labels.append(line.strip())
+    return labels if len(labels) <= MAX_LABEL_ROWS else []
+
+
+def _first_bad_line(path: Path, delimiter: str, header: list[str], skip: int) -> str:
+    """Where the rows after the first `skip` lines stop being numbers under the header, said
+    with the file's line number and the column's name."""
+    with path.open(encoding="utf-8-sig") as fh:
+        for number, line in enumerate(fh, start=1):
+            text = line.strip()
+            if number <= skip or not text or text.startswith("#"):
+                continue
+            fields = _decimal_points(text, delimiter).split(delimiter)
+            if len(fields) != len(header):
+                return f"line {number} has {len(fields)} fields, the header {len(header)}: {text[:80]!r}"
+            for name, field in zip(header, fields):
+                if not _is_number(field):
+                    return f"unreadable number in line {number}, column {name}: {field.strip()[:40]!r}"
+    return "unreadable numbers"
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def _renamed(path: Path, header: list[str], columns: dict) -> list[str]:
+    """header with the names columns maps ({ours: the file's}) replaced by ours; a column
+    of the file that has one of those names already is left unread. Names read twice are
+    refused."""
+    absent = [theirs for theirs in columns.values() if theirs not in header]
+    if absent:
+        raise RecordingError(f"{path}: --column names {', '.join(absent)}, not in the header ({','.join(header)})")
+    ours = {theirs: name for name, theirs in columns.items()}
+    header = [ours.get(h, f"{h} (replaced by --column)" if h in columns else h) for h in header]
+    twice = sorted({h for h in header if h in KNOWN_COLUMNS and header.count(h) > 1})
+    if twice:
+        raise RecordingError(f"{path}: the header has {', '.join(twice)} more than once")
+    return header
+
+
+def _column_hint(wanted, header) -> str:
+    """The --column flags that would read header names equal to wanted ones but for case,
+    spaces and punctuation (Gyr_X, GyrX, "gyr x" for gyr_x), as a hint."""
+    key = lambda name: re.sub(r"[^a-z0-9]", "", name.lower())
+    found = {key(h): h for h in header}
+    flags = [f"--column {shlex.quote(f'{c}={found[key(c)]}')}" for c in wanted if key(c) in found]
+    return f"; to read them pass {' '.join(flags)}" if flags else ""
+
+
+def _sample_grid(path: Path, t: np.ndarray, max_gap: float) -> tuple[np.ndarray, float, float]:
+    """(index of each row on a uniform grid, its rate in Hz, largest distance of a time
+    stamp from the grid in steps). Each time step counts as the whole number of median
+    steps nearest to it, so jitter below half a step is tolerated and a longer step is a
+    run of missing samples; the rate comes from the whole span, so rounded time stamps
+    do not bias it."""
+    if len(t) < 2:
+        raise RecordingError(f"{path}: one sample cannot give a sample rate; give --fs HZ")
+    dt = np.diff(t)
+    if np.any(dt <= 0):
+        r = int(np.argmax(dt <= 0))
+        raise RecordingError(f"{path}: column t must increase strictly (row {r + 2}: {t[r + 1]:g} s after {t[r]:g} s)")
+    step = float(np.median(dt))
+    count = np.rint(dt / step)
+    if np.any(count < 1):
+        r = int(np.argmax(count < 1))
+        raise RecordingError(f"{path}: column t is irregular: the step to row {r + 2} is {dt[r]:g} s, "
+                             f"less than half the usual {step:g} s")
+    index = np.concatenate([[0], np.cumsum(count)]).astype(np.int64)
+    fs = float(index[-1] / (t[-1] - t[0]))
+    check_rate(path, fs)  # before the gaps, which a wrong time unit makes look long
+    off_grid = float(np.max(np.abs(t - t[0] - index / fs)) * fs)
+    if off_grid > 0.5:
+        raise RecordingError(f"{path}: column t is irregular: time stamps up to {off_grid:.1f} steps off "
+                             f"a uniform grid at {fs:.6g} Hz (does the sample rate change?)")
+    r = int(np.argmax(count))
+    if (count[r] - 1) / fs > max_gap:
+        raise RecordingError(f"{path}: {int(count[r]) - 1} samples missing after row {r + 1} (t = {t[r]:g} s), "
+                             f"a gap of {(count[r] - 1) / fs:g} s, longer than --max-gap {max_gap:g} s; "
+                             "split the recording there or raise --max-gap")
+    return index, fs, off_grid
+
+
+def _fill_gaps(rec: Recording, index: np.ndarray) -> Recording:
+    """rec on its whole uniform grid (rows at index, ascending from 0): the rows put into
+    the gaps have gyro, accelerometer and time interpolated linearly between the rows
+    either side, no magnetometer or reference sample (NaN) and the movement flag of the
+    row before; filled marks them."""
+    grid = np.arange(index[-1] + 1)
+    filled = np.ones(len(grid), dtype=bool)
+    filled[index] = False
+    interpolated = lambda a: np.column_stack([np.interp(grid, index, c) for c in a.T])
+
+    def absent(a):
+        if a is None:
+            return None
+        out = np.full((len(grid), a.shape[1]), np.nan)
+        out[index] = a
+        return out
+
+    gaps = np.diff(index) - 1
+    count = int((gaps > 0).sum())
+    rec.notes.append(f"{rec.name}: {int(gaps.sum())} missing samples in {count} gap{'s' * (count > 1)} "
+                     f"(the longest {gaps.max() / rec.fs:g} s) filled in: gyro and accelerometer interpolated "
+                     "linearly, no magnetometer or reference sample there; estimates are written for the "
+                     "input's rows only")
+    return replace(rec, gyr=interpolated(rec.gyr), acc=interpolated(rec.acc),
+                   t=np.interp(grid, index, rec.t), mag=absent(rec.mag), quat_ref=absent(rec.quat_ref),
+                   movement=None if rec.movement is None else rec.movement[np.searchsorted(index, grid, "right") - 1],
+                   filled=filled)
+
+
+def _flag(path: Path, name: str, values) -> np.ndarray:
+    """A 0/1 column as booleans; anything else is refused."""
+    values = np.asarray(values, dtype=float)
+    bad = (values != 0) & (values != 1)
+    if bad.any():
+        r = int(np.argmax(bad))
+        raise RecordingError(f"{path}: {name} must be 0 or 1, row {r + 1} has {values[r]:g}")
+    return values == 1
+
+
+def _read_mat(path: Path, fs: float | None, columns: dict) -> Recording:
+    """A BROAD recording, its variables (MAT_VARIABLES) renamed from the file's by columns
+    ({BROAD's name: the file's}); without a sampling_rate variable, at fs (Hz) if given."""
+    from scipy.io import loadmat
+
+    try:
+        mat = loadmat(path, squeeze_me=True)
+    except NotImplementedError:  # scipy's answer to a v7.3 file
+        mat = _read_mat_v73(path)
+    except Exception as exc:  # scipy raises several types for damaged files
+        raise RecordingError(f"{path}: not a readable MATLAB file ({exc})") from None
+    variables = ", ".join(k for k in mat if not k.startswith("__")) or "none"
+    absent = [theirs for theirs in columns.values() if theirs not in mat]
+    if absent:
+        raise RecordingError(f"{path}: --column names {', '.join(absent)}, not a variable of the file ({variables})")
+    mat = {**{k: v for k, v in mat.items() if k not in columns},
+           **{ours: mat[theirs] for ours, theirs in columns.items()}}
+    missing = [k for k in ("imu_gyr", "imu_acc", *(() if fs else ("sampling_rate",))) if k not in mat]
+    if missing:
+        raise RecordingError(f"{path}: missing variables {', '.join(missing)} (expected a BROAD recording"
+                             f"{'; without sampling_rate give --fs HZ' if 'sampling_rate' in missing else ''}; "
+                             f"the file has {variables}: name them with --column, e.g. --column imu_gyr=NAME)")
+    try:
+        fs = float(mat["sampling_rate"]) if "sampling_rate" in mat else fs
+    except (TypeError, ValueError):
+        raise RecordingError(f"{path}: sampling_rate must be one number (Hz)") from None
+    gyr = np.atleast_2d(np.asarray(mat["imu_gyr"], dtype=float))
+    acc = np.atleast_2d(np.asarray(mat["imu_acc"], dtype=float))
+    n = len(gyr)
+
+    def optional(key, width):
+        if key not in mat:
+            return None
+        value = np.asarray(mat[key], dtype=float)
+        if value.size != n * max(width, 1):
+            raise RecordingError(f"{path}: {key} has {value.size} values, expected {n}"
+                                 f"{f'×{width}' if width else ''} (one per sample of imu_gyr)")
+        return value.reshape(n, width) if width else value.reshape(n)
+
+    movement = optional("movement", 0)
+    return Recording(
+        path.stem, fs, gyr, acc, np.arange(1, n + 1) / fs, optional("imu_mag", 3),
+        optional("opt_quat", 4), None if movement is None else _flag(path, "movement", movement),
+    )
+
+
+def _read_mat_v73(path: Path) -> dict:
+    """The numeric variables of a MATLAB v7.3 file (HDF5), as loadmat(squeeze_me=True)
+    gives them from older versions: HDF5 holds MATLAB's arrays transposed."""
+    import h5py
+
+    try:
+        with h5py.File(path, "r") as f:
+            return {name: np.squeeze(np.asarray(item).T) for name, item in f.items()
+                    if isinstance(item, h5py.Dataset) and item.dtype.kind in "fiub"}
+    except OSError as exc:
+        raise RecordingError(f"{path}: not a readable MATLAB v7.3 file ({exc})") from None
