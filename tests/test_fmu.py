@@ -746,11 +746,25 @@ def test_libcosim_runs_the_ssp_diagram_and_its_estimator_computes_ours(fmu_dir, 
 
 
 
+def _without_the_installed_package(folder: Path) -> dict:
+    """The environment of a Python process that imports attitude_fmu from FMUs alone: the
+    site-packages of this one but attitude_fmu, linked into folder, on PYTHONPATH (and
+    python -S, so that no install's .pth finds it)."""
+    import site
+
+    for packages in map(Path, site.getsitepackages()):
+        for entry in packages.iterdir():
+            if not entry.name.startswith(("attitude_fmu", "__editable__")) and not (folder / entry.name).exists():
+                (folder / entry.name).symlink_to(entry)
+    return dict(os.environ, PYTHONPATH=str(folder))
+
+
 def test_a_second_run_after_the_importer_deleted_the_first_fmus_folders(fmu_dir, tmp_path):
-    """libcosim deletes an execution's FMU folders when it is done with it; the project's
-    code stays loaded from the first one. A second run in the process checks its FMUs
-    against that code's digest, taken while its folder existed, and runs (before, the
-    check read the deleted folder and refused, and libcosim ended the process)."""
+    """libcosim deletes an execution's FMU folders when it is done with it; in a process
+    where attitude_fmu comes from the FMUs (none installed), the project's code stays
+    loaded from the first one. A second run in the process checks its FMUs against that
+    code's digest, taken while its folder existed, and runs (before, the check read the
+    deleted folder and refused, and libcosim ended the process)."""
     pytest.importorskip("libcosimpy")
     ssp = write_ssp(tmp_path / "short.ssp", fmu_dir, {"motion": {"profile": "step_rotation"}}, 1.0, 1 / FS)
     script = textwrap.dedent(f"""
@@ -767,7 +781,9 @@ def test_a_second_run_after_the_importer_deleted_the_first_fmus_folders(fmu_dir,
               Path(sys.modules["attitude_fmu.blocks.pipeline.online"].__file__).exists(), flush=True)
         os._exit(0)  # as systems.fmi.cosim: pythonfmu's library destructor may crash at shutdown
     """)
-    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=tmp_path)
+    (tmp_path / "site").mkdir()
+    proc = subprocess.run([sys.executable, "-S", "-c", script], capture_output=True, text=True, cwd=tmp_path,
+                          env=_without_the_installed_package(tmp_path / "site"))
     assert proc.returncode == 0, proc.stdout + proc.stderr[-2000:]
     assert proc.stdout.splitlines() == ["0 True", "1 True", "project code loaded from a folder that still exists: False"]
 
