@@ -47,7 +47,7 @@ def read_recording(path, fs: float | None = None, gyr_unit: str = "rad/s", acc_u
                    mag_unit: str = "uT", max_gap: float = MAX_GAP_S, t_unit: str = "s",
                    columns: Mapping[str, str] | None = None, gyr_axes: str | None = None,
                    acc_axes: str | None = None, mag_axes: str | None = None) -> Recording:
-    """Read a CSV (header t,gyr_x..z,acc_x..z[,mag_x..z][,ref_q_w..z][,movement]; t may be
+    """Read a CSV (header `t,gyr_x..z,acc_x..z[,mag_x..z][,ref_q_w..z][,movement]`; t may be
     replaced by fs) or a BROAD .mat, in the units given (GYR_UNITS, ACC_UNITS, MAG_UNITS,
     T_UNITS), into rad/s, m/s², µT and s (values no IMU gives: check_values). columns
     ({our name: the CSV's}) reads a header
