@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 
 from attitude_fmu.blocks.methods.registry import METHODS
-from attitude_fmu.blocks.pipeline.causal import ESTIMATORS
+from attitude_fmu.blocks.pipeline.causal import ESTIMATORS, valid_sample
 from attitude_fmu.blocks.pipeline.online import OnlineEstimator, same_step
 from attitude_fmu.fmu_src.fmu_support import IN, OUT, PAR, Fmi2Status, ProjectSlave, fmi_unit
 
@@ -131,6 +131,7 @@ class AttitudeEstimator(ProjectSlave):
             self.gyr_offset_x, self.gyr_offset_y, self.gyr_offset_z = est.offset.tolist()
             self.mag_offset_x, self.mag_offset_y, self.mag_offset_z = est.mag_offset.tolist()
             self.mag_delay_used = est.mag_delay
-        elif not all(math.isfinite(v) for v in gyr + acc):
-            self.log(f"t={current_time:g}: non-finite input; estimate held", Fmi2Status.warning)
+        elif not valid_sample(gyr, acc):
+            what = "input beyond every IMU's range" if all(map(math.isfinite, gyr + acc)) else "non-finite input"
+            self.log(f"t={current_time:g}: {what}; estimate held", Fmi2Status.warning)
         return True

@@ -473,15 +473,18 @@ def test_non_finite_inputs_hold_the_estimate_and_clear_valid(fmu_dir, recording,
     data = np.hstack([gyr, acc])[:50].copy()
     data[20, 4] = np.nan
     data[21, 0] = np.inf
+    data[22, 1] = 1e155  # finite, beyond every gyro's range
+    data[23, 5] = -5e3  # m/s², beyond every accelerometer's (±400 g)
     out, valid = runner.run(data, 1 / FS)
     runner.close()
-    assert "non-finite input" in capsys.readouterr().out
-    assert not valid[20] and not valid[21] and valid[:20].all() and valid[22:].all()
-    assert np.array_equal(out[20], out[19]) and np.array_equal(out[21], out[19])
+    log = capsys.readouterr().out
+    assert "non-finite input" in log and log.count("input beyond every IMU's range") == 2
+    assert not valid[20:24].any() and valid[:20].all() and valid[24:].all()
+    assert all(np.array_equal(out[k], out[19]) for k in range(20, 24))
     # the held samples are skipped: afterwards the estimate goes on from sample 19's state
-    kept = np.delete(data, [20, 21], axis=0)
+    kept = np.delete(data, [20, 21, 22, 23], axis=0)
     ref = estimate(kept[:, :3], kept[:, 3:], FS, gyro_offset=False)
-    assert np.abs(out[22:, :4] - ref.quat[20:]).max() < 1e-9
+    assert np.abs(out[24:, :4] - ref.quat[20:]).max() < 1e-9
 
 
 GYR_SCALE = ((0.002, 0.01, 0.0), (0.0, -0.003, 0.0), (-0.005, 0.0, 0.004))  # scale and misalignment

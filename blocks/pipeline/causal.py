@@ -42,6 +42,17 @@ from attitude_fmu.blocks.stages.timing import (
 )
 
 ESTIMATORS = {"the gyro-offset estimator": offset_stage.PARAMS, "the heading estimator": heading_stage.PARAMS}
+# beyond these no IMU measures: a sample beyond them is not taken (the widest MEMS ranges,
+# ±4000 °/s and ±400 g per axis)
+MAX_GYR_RAD_S = math.radians(4000.0)
+MAX_ACC_M_S2 = 400.0 * 9.80665
+
+
+def valid_sample(gyr, acc) -> bool:
+    """Whether a gyro (rad/s) and an accelerometer sample (m/s², 3 values each) are finite
+    and within every IMU's range, MAX_GYR_RAD_S and MAX_ACC_M_S2 per axis."""
+    return all(math.isfinite(v) and abs(v) <= MAX_GYR_RAD_S for v in gyr) and \
+        all(math.isfinite(v) and abs(v) <= MAX_ACC_M_S2 for v in acc)
 
 
 def split_params(method: str, params: Mapping[str, float] | None, offset: bool, mag: bool):

@@ -7,7 +7,7 @@ from typing import Mapping
 
 import numpy as np
 
-from attitude_fmu.blocks.pipeline.causal import Rows, State, at, configure, run
+from attitude_fmu.blocks.pipeline.causal import Rows, State, at, configure, run, valid_sample
 from attitude_fmu.blocks.quaternion import quat_euler_zyx
 from attitude_fmu.blocks.stages.heading import HARD_IRON_OFFSET, MAG_DELAY_IN_USE
 from attitude_fmu.blocks.stages.timing import same_step
@@ -21,8 +21,9 @@ class OnlineEstimator:
     method, params, gyro_offset, heading (a magnetometer is given), latency (s),
     gyr_samples and acc_samples as for blocks.pipeline.causal.configure, validated here.
     step() takes one sample; its estimate is then in quat, up, euler, offset, mag_offset
-    and mag_delay. A sample with a non-finite gyro or accelerometer value is not taken
-    (the estimate is held); a gyro point sample still counts as the one before the next.
+    and mag_delay. A sample with a gyro or accelerometer value that is not finite or beyond
+    every IMU's range (blocks.pipeline.causal.valid_sample) is not taken: the estimate is held;
+    a finite gyro point sample still counts as the one before the next.
     The stages start at rest on the first sample whose accelerometer is not all zero,
     as the batch path starts on its first sample; until then `ready` is False.
     """
@@ -77,9 +78,8 @@ class OnlineEstimator:
             self._step = at(self.pipeline, Ts)
         gyr = np.array(gyr, dtype=float).reshape(1, 3)
         acc = np.array(acc, dtype=float).reshape(1, 3)
-        finite_gyr = bool(np.isfinite(gyr).all())
-        if not (finite_gyr and np.isfinite(acc).all() and (self.ready or acc.any())):
-            if finite_gyr and self.pipeline.point_gyr:
+        if not (valid_sample(gyr[0], acc[0]) and (self.ready or acc.any())):
+            if self.pipeline.point_gyr and np.isfinite(gyr).all():
                 self.state.last_gyr = gyr[0]
             return False
         mag = np.array(mag, dtype=float).reshape(1, 3) if self.pipeline.heading_params is not None else None

@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 
+from attitude_fmu.blocks.pipeline.causal import MAX_GYR_RAD_S
 from attitude_fmu.systems.recordings.recording import (
     ACC_UNITS,
     GYR_UNITS,
@@ -17,7 +18,6 @@ from attitude_fmu.systems.recordings.recording import (
 
 RATE_RANGE_HZ = (1.0, 1e5)  # sample rates an IMU recording can have; outside, the time unit is wrong
 EARTH_FIELD_RANGE_UT = (20.0, 70.0)  # the geomagnetic field's norm anywhere on earth, about 22–67 µT
-MAX_GYRO_RAD_S = math.radians(4000.0)  # beyond the widest range of MEMS gyros (±4000 °/s): such values are not rad/s
 UNIT_TOLERANCE = 0.1  # largest departure of a reference quaternion's norm from 1 (rounded columns pass)
 SATURATION_S = 0.02  # s: a run this long at exactly a column's largest magnitude is the sensor's range
 SATURATION_LEAST = {"gyr": 2.0, "acc": 15.0}  # rad/s, m/s²: below every MEMS range (±125 °/s, ±2 g)
@@ -123,7 +123,7 @@ def check_values(rec: Recording, gyr_unit: str, acc_unit: str) -> None:
     peak = float(np.max(np.abs(rec.gyr)))
     norm = float(np.median(np.linalg.norm(rec.acc, axis=1)))
     for flag, units, given, value, plausible, what in (
-        ("--gyr-unit", GYR_UNITS, gyr_unit, peak, lambda p: p <= MAX_GYRO_RAD_S,
+        ("--gyr-unit", GYR_UNITS, gyr_unit, peak, lambda p: p <= MAX_GYR_RAD_S,
          f"gyro reaches {peak:.1f} rad/s read as {gyr_unit}, beyond any MEMS gyro"),
         ("--acc-unit", ACC_UNITS, acc_unit, norm, lambda n: 4.0 < n < 20.0,  # m/s², gravity and a person's motion
          f"median accelerometer norm is {norm:.3g} m/s² read as {acc_unit}, far from gravity"),
