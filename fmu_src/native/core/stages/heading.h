@@ -23,7 +23,8 @@
  * mag_delay (s; NaN: estimated online)], then hard_iron's and mag_delay's. */
 void heading_coefficients(double tau_heading, double mag_norm_tol, double mag_dip_tol, double tau_reference,
                           double heading_clip, double mag_new_time, double mag_new_angle, double mag_delay,
-                          double Ts, double coef[10]);
+                          double mag_cal_time, double mag_cal_spread, double mag_cal_tol, double mag_cal_recent,
+                          double tau_mag_delay, double Ts, double coef[HEADING_COEF_SIZE]);
 
 /* initial_state: nothing seen yet. */
 void heading_initial_state(double state[HEADING_STATE_SIZE]);
