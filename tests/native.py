@@ -19,10 +19,14 @@ def compiler() -> list[str]:
 
 def core_library(folder: Path, sources=None, include=()) -> ctypes.CDLL:
     """Every .c file under fmu_src/native/core (or the given ones) compiled into folder/core.so
-    and loaded; include: more header folders (generated headers)."""
+    and loaded; the generated tables (af_params.h, systems.fmi.native_tables) are written into
+    folder first; include: more header folders."""
+    from attitude_fmu.systems.fmi.native_tables import write_headers
+
     sources = sorted(CORE.rglob("*.c")) if sources is None else list(sources)
     out = Path(folder) / "core.so"
-    command = [*compiler(), *FLAGS, f"-I{CORE}", *(f"-I{d}" for d in include), "-o", str(out),
+    write_headers(folder)
+    command = [*compiler(), *FLAGS, f"-I{CORE}", f"-I{folder}", *(f"-I{d}" for d in include), "-o", str(out),
                *map(str, sources), "-lm"]
     subprocess.run(command, check=True, capture_output=True, text=True)
     return ctypes.CDLL(str(out))

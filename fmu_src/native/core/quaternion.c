@@ -92,3 +92,14 @@ Vec3 up_in_sensor(Quat q)
 {
     return quat_rotate(quat_conjugate(q), (Vec3){0.0, 0.0, 1.0});
 }
+
+void write_sample(double gravity[3], double quat[4], double g, Vec3 up, const double q[4])
+{
+    gravity[0] = g * up.x;
+    gravity[1] = g * up.y;
+    gravity[2] = g * up.z;
+    quat[0] = q[0];
+    quat[1] = q[1];
+    quat[2] = q[2];
+    quat[3] = q[3];
+}

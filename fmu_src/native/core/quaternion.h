@@ -17,5 +17,7 @@ Quat level_quat(Vec3 u, double norm);                    /* smallest rotation of
 Vec3 quat_euler_zyx(Quat q);                             /* roll, pitch, yaw (rad) of the Z-Y-X sequence */
 Vec3 up_in_sensor(Quat q);                               /* earth up in sensor coordinates: R(q)^T z */
 Quat quat_conjugate(Quat q);                             /* the inverse of a unit quaternion */
+/* a kernel method's output for one sample: gravity g up (m/s^2, g the magnitude) and quat = q */
+void write_sample(double gravity[3], double quat[4], double g, Vec3 up, const double q[4]);
 
 #endif
