@@ -17,25 +17,24 @@
 #define CLIP_SIGMAS 4.0 /* innovations clipped at this many sigma_init */
 #define SETTLE_TAUS 3.0 /* no update before this many tau_acc (the low-pass forgetting its start) */
 
-void gyro_offset_coefficients(double rest_gyr, double rest_gyr_abs, double rest_acc, double rest_time,
-                              double tau_lp, double tau_short, double delta_n, double tau_acc, double sigma_init,
-                              double sigma_motion, double tau_motion, double Ts, double coef[GYRO_OFFSET_COEF_SIZE])
+void gyro_offset_coefficients(const double params[AF_N_PARAMS], double Ts, double coef[GYRO_OFFSET_COEF_SIZE])
 {
-    double s2 = sigma_motion * sigma_motion;
+    double tau_motion = params[AF_P_tau_motion], s2 = params[AF_P_sigma_motion] * params[AF_P_sigma_motion];
     double V = tau_motion > 0 ? s2 * Ts / tau_motion : 0.0;
-    double noise_floor = REST_NOISE_SIGMAS * delta_n / sqrt(4 * tau_short);
+    double delta_n = params[AF_P_delta_n];
+    double noise_floor = REST_NOISE_SIGMAS * delta_n / sqrt(4 * params[AF_P_tau_short]);
     coef[0] = Ts;
-    coef[1] = 1.0 - exp(-Ts / tau_lp);
+    coef[1] = 1.0 - exp(-Ts / params[AF_P_tau_lp]);
     coef[2] = delta_n * delta_n / (2.0 * Ts);
-    coef[3] = noise_floor > rest_gyr ? noise_floor : rest_gyr;
-    coef[4] = rest_gyr_abs;
-    coef[5] = rest_acc;
-    coef[6] = rest_time;
-    coef[7] = sqrt(2.0) / tau_acc * Ts;
-    coef[8] = sigma_init * sigma_init;
+    coef[3] = noise_floor > params[AF_P_rest_gyr] ? noise_floor : params[AF_P_rest_gyr];
+    coef[4] = params[AF_P_rest_gyr_abs];
+    coef[5] = params[AF_P_rest_acc];
+    coef[6] = params[AF_P_rest_time];
+    coef[7] = sqrt(2.0) / params[AF_P_tau_acc] * Ts;
+    coef[8] = params[AF_P_sigma_init] * params[AF_P_sigma_init];
     coef[9] = V;
     coef[10] = V > 0 ? s2 * s2 / V + s2 : 0.0;
-    coef[11] = 1.0 - exp(-Ts / tau_short);
+    coef[11] = 1.0 - exp(-Ts / params[AF_P_tau_short]);
 }
 
 void gyro_offset_initial_state(const double coef[GYRO_OFFSET_COEF_SIZE], const double gyr0[3], const double acc0[3],

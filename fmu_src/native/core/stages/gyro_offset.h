@@ -5,15 +5,15 @@
 
 #include <stddef.h>
 
+#include "af_params.h"
+
 #define GYRO_OFFSET_STATE_SIZE 60 /* len(STATE_NAMES) */
 #define GYRO_OFFSET_COEF_SIZE 12  /* see gyro_offset_coefficients */
 #define REST_NOISE_SIGMAS 4.5     /* the least rest_gyr in units of the gyro noise's per-axis s.d. through tau_short */
 
 /* coefficients: [Ts, a_lp, r, rest_gyr, rest_gyr_abs, rest_acc, rest_time, w_acc*Ts, P0, V, W, a_short]
- * from the stage's parameters (rad/s, m/s^2, s as blocks/stages/gyro_offset.py) at Ts (s). */
-void gyro_offset_coefficients(double rest_gyr, double rest_gyr_abs, double rest_acc, double rest_time,
-                              double tau_lp, double tau_short, double delta_n, double tau_acc, double sigma_init,
-                              double sigma_motion, double tau_motion, double Ts, double coef[GYRO_OFFSET_COEF_SIZE]);
+ * from the stage's resolved parameters (AF_P_<name>) at Ts (s). */
+void gyro_offset_coefficients(const double params[AF_N_PARAMS], double Ts, double coef[GYRO_OFFSET_COEF_SIZE]);
 
 /* initial_state: low-passes on the first samples gyr0 (rad/s), acc0 (m/s^2), no offset. */
 void gyro_offset_initial_state(const double coef[GYRO_OFFSET_COEF_SIZE], const double gyr0[3], const double acc0[3],

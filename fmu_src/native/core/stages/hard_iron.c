@@ -16,13 +16,12 @@
 
 static const double PI = 3.14159265358979323846;
 
-void hard_iron_coefficients(double mag_cal_time, double mag_cal_spread, double mag_cal_tol, double mag_cal_recent,
-                            double Ts, double coef[HARD_IRON_COEF_SIZE])
+void hard_iron_coefficients(const double params[AF_N_PARAMS], double Ts, double coef[HARD_IRON_COEF_SIZE])
 {
-    double cal_steps = mag_cal_time / Ts, recent_steps = mag_cal_recent / Ts;
+    double cal_steps = params[AF_P_mag_cal_time] / Ts, recent_steps = params[AF_P_mag_cal_recent] / Ts;
     coef[0] = cal_steps;
-    coef[1] = mag_cal_spread;
-    coef[2] = mag_cal_tol;
+    coef[1] = params[AF_P_mag_cal_spread];
+    coef[2] = params[AF_P_mag_cal_tol];
     coef[3] = recent_steps;
     coef[4] = cal_steps > 0.0 ? 1.0 - exp(-1.0 / cal_steps) : 0.0;
     coef[5] = 1.0 - exp(-1.0 / recent_steps);

@@ -3,6 +3,7 @@
 #ifndef AF_HARD_IRON_H
 #define AF_HARD_IRON_H
 
+#include "af_params.h"
 #include "quaternion.h"
 
 #define HARD_IRON_STATE_SIZE 23  /* STATE_SIZE */
@@ -11,8 +12,7 @@
 
 /* coefficients: [mag_cal_time/Ts, mag_cal_spread, mag_cal_tol, mag_cal_recent/Ts,
  * 1 - exp(-Ts/mag_cal_time) (0 when off), 1 - exp(-Ts/mag_cal_recent)]. */
-void hard_iron_coefficients(double mag_cal_time, double mag_cal_spread, double mag_cal_tol, double mag_cal_recent,
-                            double Ts, double coef[HARD_IRON_COEF_SIZE]);
+void hard_iron_coefficients(const double params[AF_N_PARAMS], double Ts, double coef[HARD_IRON_COEF_SIZE]);
 
 /* pull: 1 - exp(-gap*rate), a first-order low-pass's weight over gap steps; one_step its value for one. */
 double pull(double gap, double rate, double one_step);

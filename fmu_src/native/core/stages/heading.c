@@ -19,23 +19,20 @@
 
 static const double PI = 3.14159265358979323846;
 
-void heading_coefficients(double tau_heading, double mag_norm_tol, double mag_dip_tol, double tau_reference,
-                          double heading_clip, double mag_new_time, double mag_new_angle, double mag_delay,
-                          double mag_cal_time, double mag_cal_spread, double mag_cal_tol, double mag_cal_recent,
-                          double tau_mag_delay, double Ts, double coef[HEADING_COEF_SIZE])
+void heading_coefficients(const double params[AF_N_PARAMS], double Ts, double coef[HEADING_COEF_SIZE])
 {
-    coef[0] = Ts / tau_heading;
-    coef[1] = Ts / tau_reference;
-    coef[2] = mag_norm_tol;
-    coef[3] = mag_dip_tol;
-    coef[4] = heading_clip;
-    coef[5] = mag_new_time / Ts;
-    coef[6] = cos(0.5 * mag_new_angle);
-    coef[7] = 1.0 - exp(-Ts / tau_heading);
-    coef[8] = 1.0 - exp(-Ts / tau_reference);
-    coef[9] = mag_delay; /* NaN: unset, estimated online */
-    hard_iron_coefficients(mag_cal_time, mag_cal_spread, mag_cal_tol, mag_cal_recent, Ts, coef + HARD_IRON_COEF);
-    mag_delay_coefficients(tau_mag_delay, Ts, coef + MAG_DELAY_COEF);
+    coef[0] = Ts / params[AF_P_tau_heading];
+    coef[1] = Ts / params[AF_P_tau_reference];
+    coef[2] = params[AF_P_mag_norm_tol];
+    coef[3] = params[AF_P_mag_dip_tol];
+    coef[4] = params[AF_P_heading_clip];
+    coef[5] = params[AF_P_mag_new_time] / Ts;
+    coef[6] = cos(0.5 * params[AF_P_mag_new_angle]);
+    coef[7] = 1.0 - exp(-Ts / params[AF_P_tau_heading]);
+    coef[8] = 1.0 - exp(-Ts / params[AF_P_tau_reference]);
+    coef[9] = params[AF_P_mag_delay]; /* NaN: unset, estimated online */
+    hard_iron_coefficients(params, Ts, coef + HARD_IRON_COEF);
+    mag_delay_coefficients(params, Ts, coef + MAG_DELAY_COEF);
 }
 
 void heading_initial_state(double state[HEADING_STATE_SIZE])

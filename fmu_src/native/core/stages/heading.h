@@ -5,6 +5,7 @@
 
 #include <stddef.h>
 
+#include "af_params.h"
 #include "quaternion.h"
 #include "stages/hard_iron.h"
 #include "stages/mag_delay.h"
@@ -21,10 +22,7 @@
 /* coefficients: [Ts/tau_heading, Ts/tau_reference, mag_norm_tol, mag_dip_tol, heading_clip,
  * mag_new_time/Ts, cos(mag_new_angle/2), 1 - exp(-Ts/tau_heading), 1 - exp(-Ts/tau_reference),
  * mag_delay (s; NaN: estimated online)], then hard_iron's and mag_delay's. */
-void heading_coefficients(double tau_heading, double mag_norm_tol, double mag_dip_tol, double tau_reference,
-                          double heading_clip, double mag_new_time, double mag_new_angle, double mag_delay,
-                          double mag_cal_time, double mag_cal_spread, double mag_cal_tol, double mag_cal_recent,
-                          double tau_mag_delay, double Ts, double coef[HEADING_COEF_SIZE]);
+void heading_coefficients(const double params[AF_N_PARAMS], double Ts, double coef[HEADING_COEF_SIZE]);
 
 /* initial_state: nothing seen yet. */
 void heading_initial_state(double state[HEADING_STATE_SIZE]);

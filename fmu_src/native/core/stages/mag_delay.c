@@ -14,11 +14,11 @@
 #define SUMS 17   /* sum y.J.dt, |J|^2.dt, |y|^2.dt, dt (forgotten over tau_mag_delay) */
 #define DELAY MAG_DELAY_STATE_DELAY /* the delay in use (s) */
 
-void mag_delay_coefficients(double tau_mag_delay, double Ts, double coef[MAG_DELAY_COEF_SIZE])
+void mag_delay_coefficients(const double params[AF_N_PARAMS], double Ts, double coef[MAG_DELAY_COEF_SIZE])
 {
     coef[0] = Ts;
     coef[1] = 1.0 / MAG_SPAN_S;
-    coef[2] = 1.0 / tau_mag_delay;
+    coef[2] = 1.0 / params[AF_P_tau_mag_delay];
     coef[3] = MAG_DELAY_SIGMAS;
     coef[4] = MAG_DELAY_REACH_S;
     coef[5] = MAG_DELAY_MIN_S;

@@ -3,6 +3,7 @@
 #ifndef AF_MAG_DELAY_H
 #define AF_MAG_DELAY_H
 
+#include "af_params.h"
 #include "quaternion.h"
 
 #define MAG_SPAN_S 0.25       /* s: the field is compared with the gyro over about this long */
@@ -14,7 +15,7 @@
 #define MAG_DELAY_STATE_DELAY 21 /* DELAY: the delay in use (s) */
 
 /* coefficients: [Ts (s), 1/MAG_SPAN_S, 1/tau_mag_delay, MAG_DELAY_SIGMAS, MAG_DELAY_REACH_S, MAG_DELAY_MIN_S]. */
-void mag_delay_coefficients(double tau_mag_delay, double Ts, double coef[MAG_DELAY_COEF_SIZE]);
+void mag_delay_coefficients(const double params[AF_N_PARAMS], double Ts, double coef[MAG_DELAY_COEF_SIZE]);
 
 /* turn: every step, the step's rotation (rad) added to the integrated rate. */
 void mag_delay_turn(double state[MAG_DELAY_STATE_SIZE], const double coef[MAG_DELAY_COEF_SIZE], Vec3 rotation);
