@@ -14,7 +14,7 @@ import math
 import numpy as np
 
 from attitude_fmu.blocks.stages.timing import same_step
-from attitude_fmu.fmu_src.fmu_support import IN, OUT, PAR, Integer, ProjectSlave
+from attitude_fmu.fmu_src.fmu_support import IN, INTEGER, OUT, PAR, ProjectSlave
 from attitude_fmu.systems.simulation.motion import EARTH_FIELD_UT
 from attitude_fmu.systems.simulation.sensor_model import ImuModel, mag_noise_generator
 
@@ -43,7 +43,7 @@ class ImuSensor(ProjectSlave):
         self.real("latency", 0.0, "s", "how long gyr and acc lag the motion (a fixed step needed)", PAR)
         self.real("mag_noise", 0.0, "uT/sqrt(Hz)", "magnetometer white-noise density, one-sided", PAR)
         self.vector("mag_offset", (0.0, 0.0, 0.0), "uT", "hard iron: a field {c} fixed to the sensor", PAR)
-        self.parameter("seed", 1, "seed of the noise generator", Integer)
+        self.parameter("seed", 1, "seed of the noise generator", INTEGER)
         self.model = None
 
     def initialise(self):

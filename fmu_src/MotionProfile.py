@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from scipy.spatial.transform import Rotation
 
-from attitude_fmu.fmu_src.fmu_support import OUT, PAR, Integer, ProjectSlave, fmi_unit
+from attitude_fmu.fmu_src.fmu_support import INTEGER, OUT, PAR, ProjectSlave, fmi_unit
 from attitude_fmu.systems.simulation.motion import EARTH_FIELD_UT, PROFILES, profile
 
 
@@ -25,7 +25,7 @@ class MotionProfile(ProjectSlave):
         self.vector("qt", (1.0, 0.0, 0.0, 0.0), "1", "true orientation quaternion {c}, sensor -> earth (ENU)", OUT,
                     "wxyz")
         self.parameter("profile", "human", f"motion profile: {', '.join(PROFILES)}")
-        self.parameter("seed", 0, "seed of random profiles", Integer)
+        self.parameter("seed", 0, "seed of random profiles", INTEGER)
         self.real("g", 9.81, "m/s2", "magnitude of gravity", PAR)
         for prof in PROFILES.values():
             for p in prof.params:

@@ -69,6 +69,7 @@ def test_fmus_built_from_other_sources_are_rebuilt(fmu_dir, tmp_path):
     for name in FMU_NAMES:
         shutil.copy(fmu_dir / f"{name}.fmu", tmp_path)
         assert built_from(tmp_path / f"{name}.fmu") == source_fingerprint(name)
+    shutil.copytree(fmu_dir / "native", tmp_path / "native")
     assert len({source_fingerprint(name) for name in FMU_NAMES}) == len(FMU_NAMES)
     logs = []
     ensure_built(tmp_path, log=logs.append)
