@@ -2,12 +2,16 @@
 twins (blocks/stages, blocks/pipeline) through ctypes: the same state and coefficient arrays
 in, the same states and outputs out, step by step, on streams that take every branch."""
 import ctypes
+import functools
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from attitude_fmu.blocks.methods.registry import METHODS
+from attitude_fmu.blocks.pipeline.online import OnlineEstimator
 from attitude_fmu.blocks.quaternion import integrate_rates
 from attitude_fmu.blocks.stages import gyro_offset, heading
 from attitude_fmu.fmu_src.AttitudeEstimator import tuning_parameters
@@ -26,15 +30,26 @@ STATE_RTOL = 1e-11
 
 @pytest.fixture(scope="module")
 def lib(tmp_path_factory):
+    """The whole C core with tests/native_online.c, the online estimator's loop over arrays."""
     folder = tmp_path_factory.mktemp("native_core")
-    return core_library(folder, [CORE / "quaternion.c", *(CORE / "stages" / f"{n}.c" for n in ("gyro_offset", "hard_iron", "heading", "mag_delay"))],
-                        include=[write_headers(folder).parent])
+    lib = core_library(folder, [*sorted(CORE.rglob("*.c")), Path(__file__).with_name("native_online.c")],
+                       include=[write_headers(folder).parent])
+    lib.online_size.restype = ctypes.c_size_t
+    lib.online_init.argtypes = [ctypes.c_void_p, ctypes.c_char_p, _DOUBLES, ctypes.c_int, ctypes.c_int,
+                                ctypes.c_double, ctypes.c_char_p, ctypes.c_char_p, ctypes.c_char_p, ctypes.c_size_t]
+    lib.online_run.argtypes = [ctypes.c_void_p, ctypes.c_size_t, _DOUBLES, _DOUBLES, _DOUBLES, _DOUBLES, _INTS,
+                               _DOUBLES, ctypes.c_char_p, ctypes.c_size_t]
+    lib.online_run.restype = ctypes.c_size_t
+    return lib
+
+
+_DOUBLES = np.ctypeslib.ndpointer(np.float64, flags="C_CONTIGUOUS")
+_INTS = np.ctypeslib.ndpointer(np.intc, flags="C_CONTIGUOUS")
 
 
 def _doubles(lib, name, count):
     """Declare lib.name's arguments as count C-contiguous double arrays (an int array where count holds "i")."""
-    types = {"d": np.ctypeslib.ndpointer(np.float64, flags="C_CONTIGUOUS"),
-             "i": np.ctypeslib.ndpointer(np.intc, flags="C_CONTIGUOUS"), "n": ctypes.c_size_t, "f": ctypes.c_double}
+    types = {"d": _DOUBLES, "i": _INTS, "n": ctypes.c_size_t, "f": ctypes.c_double}
     function = getattr(lib, name)
     function.argtypes = [types[c] for c in count]
     function.restype = None
@@ -230,3 +245,106 @@ def test_heading_step_equals_its_python_twin(lib, stream):
         assert any(70 * fs < k < 90 * fs for k in restarts) and accepted[int(90 * fs):int(110 * fs)].all()
     if stream.startswith("late"):
         assert delay[-1] == pytest.approx(0.02, abs=2e-3) and used[-1]
+
+
+# ---- the online estimator (pipeline/online.h against blocks.pipeline.online.OnlineEstimator)
+
+ONLINE_ATOL = 1e-9  # every output, every step
+OUTPUTS = 17  # quat 4, up 3, euler 3, offset 3, mag_offset 3, mag_delay 1 (tests/native_online.c)
+EULER = slice(7, 10)
+MESSAGE_SIZE = 4096
+
+
+class NativeOnline:
+    """An AfOnline in a buffer of its own, configured as OnlineEstimator(**kwargs)."""
+
+    def __init__(self, lib, method="wiener", params=None, heading=False, gyro_offset=True, latency=0.0,
+                 gyr_samples="mean", acc_samples="point"):
+        self.lib, self.est = lib, ctypes.create_string_buffer(lib.online_size())
+        message = ctypes.create_string_buffer(MESSAGE_SIZE)
+        if lib.online_init(self.est, method.encode(), _param_vector(params or {}), int(heading), int(gyro_offset),
+                           latency, gyr_samples.encode(), acc_samples.encode(), message, MESSAGE_SIZE):
+            raise ValueError(message.value.decode())
+
+    def run(self, gyr, acc, mag, Ts):
+        """(status N, outputs N × OUTPUTS) of the steps; ValueError with the message of one that fails."""
+        n = len(gyr)
+        status, out = np.zeros(n, dtype=np.intc), np.full((n, OUTPUTS), np.nan)
+        message = ctypes.create_string_buffer(MESSAGE_SIZE)
+        arrays = [np.ascontiguousarray(a, dtype=float) for a in (gyr, acc, mag, Ts)]
+        if self.lib.online_run(self.est, n, *arrays, status, out, message, MESSAGE_SIZE) < n:
+            raise ValueError(message.value.decode())
+        return status, out
+
+
+def _python_run(est, gyr, acc, mag, Ts):
+    """The same through blocks.pipeline.online.OnlineEstimator, step by step."""
+    status, out = np.zeros(len(gyr), dtype=np.intc), np.empty((len(gyr), OUTPUTS))
+    for k in range(len(gyr)):
+        status[k] = est.step(gyr[k], acc[k], Ts[k], mag[k])
+        out[k] = np.concatenate([est.quat, est.up, est.euler, est.offset, est.mag_offset, [est.mag_delay]])
+    return status, out
+
+
+def _assert_same_run(python, native, what):
+    (status, out), (c_status, c_out) = python, native
+    assert np.array_equal(status, c_status), f"{what}: samples taken differ"
+    difference = np.abs(out - c_out)
+    difference[:, EULER] = np.abs(np.angle(np.exp(1j * (out[:, EULER] - c_out[:, EULER]))))  # angles wrap at ±π
+    worst = difference.max()
+    assert worst <= ONLINE_ATOL, f"{what}: largest difference {worst:.3g} (output {np.argmax(difference.max(axis=0))})"
+    return worst
+
+
+@functools.lru_cache(maxsize=None)
+def _human_stream(seed=5):
+    """Three samples with the accelerometer all 0 (not started yet), 2.5 s at rest, 12 s of human
+    motion (about 1 rad/s per axis), the step size changed from 10 ms to 8 ms at 8 s; a gyro
+    offset, hard iron and a magnetometer two samples late at a third of the IMU rate (NaN
+    between its samples); NaN, ±inf and beyond-range inputs here and there: (gyr, acc, mag, Ts)."""
+    imu = ImuModel(delta_n=math.radians(0.05), gyr_offset=(0.01, -0.02, 0.005), acc_noise=0.01, mag_noise=0.03,
+                   mag_offset=(12.0, -4.0, 7.0))
+    rest, moving = HumanMotion(delta_v=1e-12, rot_rms=0.0).stream(seed), HumanMotion(0.5, rot_rms=1.0).stream(seed + 1)
+    noise, t = np.random.default_rng(seed), 0.0
+    gyr, acc, field, Ts = [], [], [], []
+    for k in range(1450):
+        h = 0.01 if t < 8.0 else 0.008
+        t += h
+        omega, f, q = (rest if k < 250 else moving).step(t, h)
+        g, a = imu.measure(omega, f, noise.standard_normal(6), 1.0 / h)
+        gyr.append(g), acc.append(a), Ts.append(h)
+        field.append(imu.measure_mag(Rotation.from_quat(q, scalar_first=True).inv().apply(EARTH_FIELD_UT),
+                                     noise.standard_normal(3), 1.0 / h))
+    gyr, acc, Ts = np.array(gyr), np.array(acc), np.array(Ts)
+    mag = np.vstack([np.repeat(field[:1], 2, axis=0), field[:-2]])  # two samples late
+    mag[np.arange(len(mag)) % 3 != 0] = np.nan
+    acc[:3] = 0.0
+    gyr[600, 1], acc[601, 0], gyr[602, 2], acc[900, 2] = np.nan, np.inf, -np.inf, np.nan
+    gyr[603, 0], acc[604, 1] = math.radians(4001.0), 401.0 * 9.80665  # beyond every IMU's range
+    mag[606, 2], mag[609] = np.inf, 0.0  # no field sample
+    return gyr, acc, mag, Ts
+
+
+def _stage_params(heading, gyro_offset):
+    """Shorter time constants, so that a short run takes the stages' branches: the rest, the
+    tracking while moving, the heading's start-up and guard; delta_n to the gyro-offset
+    estimator and to the method where it has one."""
+    params = {"delta_n": math.radians(0.05), "rest_time": 1.0, "tau_acc": 1.0} if gyro_offset else {}
+    return {**params, "tau_heading": 2.0, "mag_new_time": 4.0, "mag_cal_time": 8.0} if heading else params
+
+
+@pytest.mark.parametrize("latency", [0.0, 0.003])
+@pytest.mark.parametrize("acc_samples", ["point", "mean"])
+@pytest.mark.parametrize("gyr_samples", ["mean", "point"])
+@pytest.mark.parametrize("gyro_offset", [True, False])
+@pytest.mark.parametrize("heading", [True, False])
+@pytest.mark.parametrize("method", list(METHODS))
+def test_online_step_equals_the_python_online_estimator(lib, method, heading, gyro_offset, gyr_samples,
+                                                        acc_samples, latency):
+    config = dict(method=method, params=_stage_params(heading, gyro_offset), heading=heading,
+                  gyro_offset=gyro_offset, latency=latency, gyr_samples=gyr_samples, acc_samples=acc_samples)
+    stream = _human_stream()
+    python = _python_run(OnlineEstimator(**config), *stream)
+    worst = _assert_same_run(python, NativeOnline(lib, **config).run(*stream), str(config))
+    assert not python[0][:3].any() and python[0][3:600].all() and not python[0][600:605].any()
+    print(f"largest difference {worst:.2g}")

@@ -1,17 +1,18 @@
 /* online.h: the causal pipeline one sample at a time (an FMU's doStep), the sample time taken
- * from each call. Python twin: blocks/pipeline/online.py (OnlineEstimator). */
+ * from each call. Python twin: blocks/pipeline/online.py (OnlineEstimator).
+ * Units: gyr rad/s, acc m/s^2, mag uT, Ts and latency s; q sensor -> earth [w, x, y, z]. */
 #ifndef AF_ONLINE_H
 #define AF_ONLINE_H
 
 #include <stddef.h>
 
-#include "af_params.h"        /* AF_N_PARAMS and the index of every tuning parameter (generated) */
+#include "af_params.h" /* AF_N_PARAMS and AF_P_<name>, the index of every tuning parameter (generated) */
 #include "pipeline/causal.h"
 
 /* What OnlineEstimator's constructor takes. */
 typedef struct {
     const char *method;         /* "wiener", "first_order", "luinge", "tseng", "tseng_adaptive", "mahony" */
-    double params[AF_N_PARAMS]; /* every tuning parameter by its generated index; NaN: not given */
+    double params[AF_N_PARAMS]; /* every tuning parameter by its index AF_P_<name>; NaN: not given */
     int heading;                /* 1: the magnetometer's heading stage runs (FMU heading "mag") */
     int gyro_offset;            /* 1: the gyro-offset stage runs */
     double latency;             /* s, within +-MAX_LATENCY_S */
@@ -23,32 +24,39 @@ typedef struct {
  * and the outputs. Plain data, no pointers: an FMU state is a copy of it. */
 typedef struct {
     AfPipeline pipeline;        /* the configuration, validated */
-    AfStep step;                /* the pipeline at the last sample time; step.Ts == 0: none yet */
+    int discretised;            /* 1: step holds the pipeline at the last sample time */
+    AfStep step;
     AfState state;              /* what the stages carry from sample to sample */
-    int ready;                  /* 1 once a sample was taken (the stages started) */
-    /* the estimate after the last sample taken */
+    /* the estimate after the last sample taken (held while samples are not taken) */
     double quat[4];             /* sensor -> earth, [w, x, y, z] */
     double up[3];               /* unit up-vector, sensor coordinates */
     double euler[3];            /* roll, pitch, yaw (rad, Z-Y-X) of quat */
     double offset[3];           /* gyro-offset estimate (rad/s; 0 without that stage) */
     double mag_offset[3];       /* hard-iron offset estimate (uT; 0 until one is proven) */
-    double mag_delay;           /* the magnetometer's delay the heading allows for (s) */
+    double mag_delay;           /* the magnetometer's delay the heading allows for (s): the parameter
+                                   mag_delay, or its online estimate (0 until one is taken) */
 } AfOnline;
 
-/* 0, or -1 with a message (the refusals of blocks.pipeline.causal.configure, its messages). */
+/* 0, or -1 with a message (the refusals of blocks.pipeline.causal.configure, its messages;
+ * a sensor-frame method's design is refused here already, where Python refuses it at the
+ * first step). */
 int af_online_init(AfOnline *est, const AfConfig *config, char *message, size_t size);
 
-/* Forget every sample; the configuration stays (OnlineEstimator.reset). */
+/* Forget every sample; the configuration and the discretisation stay (OnlineEstimator.reset). */
 void af_online_reset(AfOnline *est);
 
-/* The pipeline discretised at Ts (s) now, as the next step would: 0, or -1 with a message (Ts not
- * finite and positive, or parameters whose coefficients at Ts are not finite, e.g. delta_n=1e300). */
+/* The pipeline discretised at Ts (s) now, as a step at Ts would: 0, or -1 with a message (Ts not
+ * finite and positive, or coefficients that overflow at Ts, e.g. delta_n = 1e300), the last
+ * discretisation kept. A model calls it at initialisation with its nominal Ts to refuse such
+ * parameters there. */
 int af_online_discretise(AfOnline *est, double Ts, char *message, size_t size);
 
 /* One sample: gyr (rad/s) over the last Ts s, acc (m/s^2) and mag (uT; a NaN or all 0: no field
- * sample) now. 1: taken (the outputs are new); 0: not taken, the estimate held (an input not
- * finite or beyond every IMU's range, blocks.pipeline.causal.valid_sample, or an accelerometer
- * all 0 before the start); -1: error with a message (af_online_discretise's). */
+ * sample) now. A Ts within STEP_TOLERANCE of the last one keeps its discretisation.
+ * 1: taken (the outputs are new); 0: not taken, the estimate held (a gyro or accelerometer
+ * value not finite or beyond every IMU's range, valid_sample; or an accelerometer all 0 before
+ * the start; a finite gyro point sample still counts as the one before the next);
+ * -1: error with af_online_discretise's message. */
 int af_online_step(AfOnline *est, const double gyr[3], const double acc[3], const double mag[3], double Ts,
                    char *message, size_t size);
 

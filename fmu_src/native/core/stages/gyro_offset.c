@@ -3,6 +3,7 @@
 
 #include <math.h>
 
+#include "methods/wiener_local.h"
 #include "quaternion.h"
 
 /* the state's layout (STATE_NAMES): low-passed gyro 0..2, accelerometer 3..5, time at rest 6, offset b 7..9 */
@@ -49,22 +50,6 @@ void gyro_offset_initial_state(const double coef[GYRO_OFFSET_COEF_SIZE], const d
         state[COV + 4 * i] = coef[8]; /* P0 on the diagonal */
     }
     state[QUAT] = 1.0;
-}
-
-/* butterworth_zoh: Ad = exp(M wt), Bd = M^-1 (Ad - I) [0, 1] of eq. 34's Butterworth (twin in
- * blocks/methods/wiener_local.py); a stand-in until methods/wiener_local.h holds it */
-static void butterworth_zoh_standin(double wt, double Ad[4], double Bd[2])
-{
-    const double SQRT2 = sqrt(2.0);
-    double a = wt / SQRT2;
-    double e = exp(-a);
-    double c = e * cos(a), s = e * sin(a) * SQRT2;
-    Ad[0] = c + s / SQRT2;
-    Ad[1] = s;
-    Ad[2] = -s;
-    Ad[3] = c - s / SQRT2;
-    Bd[0] = -SQRT2 * Ad[1] - (Ad[3] - 1.0);
-    Bd[1] = Ad[1];
 }
 
 /* lowpass_step: column j of the Butterworth's two state rows (rows, each of width columns) after the input x */
@@ -208,7 +193,7 @@ void gyro_offset_step(double state[GYRO_OFFSET_STATE_SIZE], const double coef[GY
     double settle = SETTLE_TAUS * start_mean;
     double clip = CLIP_SIGMAS * sqrt(P0);
     double Ad[4], Bd[2];
-    butterworth_zoh_standin(wt, Ad, Bd);
+    butterworth_zoh(wt, Ad, Bd);
     double *b = state + 7, *acc_lp = state + ACC_LP, *r_lp = state + R_LP, *rb_lp = state + RB_LP, *P = state + COV;
     double dg2 = 0.0, da2 = 0.0, g2 = 0.0;
     for (int i = 0; i < 3; i++) {
