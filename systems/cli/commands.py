@@ -224,7 +224,8 @@ def build_parser() -> argparse.ArgumentParser:
     bn.add_argument("--json", action="store_true")
     bn.add_argument("--samples", type=int, default=100_000)
     bn.add_argument("--fmu", action="store_true",
-                    help="per-step cost of AttitudeEstimator.fmu against a no-op FMU of the same interface")
+                    help="per-step cost of AttitudeEstimator.fmu against a no-op FMU of the same interface, pythonfmu "
+                         "and native, under fmpy; and of the native against the pythonfmu one in a C host")
     bn.add_argument("--repeat", type=int, default=10, help="interleaved rounds; each method's best run counts (default 10)")
     return parser
 
@@ -440,13 +441,18 @@ def cmd_verify(args) -> int:
     if args.json:
         print(json.dumps({"rows": rows}, indent=2))
     else:
-        print(f"{'profile':>15} {'method':>14} {'rms °':>8} {'max °':>8} {'mean °':>9}  {'bound °':>8} {'on':>4}  result")
+        print(f"{'profile':>15} {'method':>14} {'rms °':>8} {'max °':>8} {'mean °':>9}  {'bound °':>8} {'on':>4}  result"
+              f"  {'native Δ':>9}")
         for r in rows:
             bound = "       —" if r["bound_deg"] is None else f"{r['bound_deg']:8.3g}"
             result = "report" if r["bound_deg"] is None else "pass" if r["pass"] else "FAIL"
+            native = "        —" if r["native_max_diff"] is None else \
+                f"{r['native_max_diff']:9.2g}" + ("" if r["native_valid_equal"] else " (valid differs)")
             print(f"{r['profile']:>15} {r['method']:>14} {r['rms_deg']:8.3g} {r['max_deg']:8.3g} {r['mean_deg']:9.3g}"
-                  f"  {bound} {r['metric']:>4}  {result}")
+                  f"  {bound} {r['metric']:>4}  {result:<6}  {native}")
         print("profiles: " + "; ".join(f"{n}: {PROFILES[n].summary}" for n in dict.fromkeys(r["profile"] for r in rows)))
+        print("native Δ: the largest difference between the outputs of the native estimator FMU (in C) and the "
+              "pythonfmu one, side by side in the co-simulation (— without a native FMU)")
     failed = [r for r in rows if not r["pass"]]
     if failed:
         print(f"attitude: {len(failed)} of {len(rows)} rows missed their bound", file=sys.stderr)
@@ -498,8 +504,13 @@ def cmd_bench(args) -> int:
         else:
             print(f"{result['steps']} steps under fmpy, best of {args.repeat} interleaved rounds")
             for name, us in result["us_per_step"].items():
-                print(f"{name:>18} {us:8.1f} µs/step")
-            print(f"{'ratio':>18} {result['ratio_vs_noop']:8.2f}")
+                print(f"{name:>24} {us:8.2f} µs/step")
+            print(f"{'ratio':>24} {result['ratio_vs_noop']:8.2f}  (pythonfmu: estimator / no-op)")
+            print(f"{'native ratio':>24} {result['native_ratio_vs_noop']:8.2f}  (in C: estimator / no-op; target ≤ 1.2)")
+            print(f"in a C host with no Python, best of {args.repeat} rounds")
+            for name, us in result["c_host_us_per_step"].items():
+                print(f"{name:>24} {us:8.3f} µs/step")
+            print(f"{'native speed-up':>24} {result['native_speedup_c_host']:8.1f}  (pythonfmu / native; target ≥ 20)")
         return 0
     result = bench(n=args.samples, repeat=args.repeat)
     if args.json:
