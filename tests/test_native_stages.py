@@ -4,6 +4,7 @@ in, the same states and outputs out, step by step, on streams that take every br
 import ctypes
 import functools
 import math
+import os
 from pathlib import Path
 
 import numpy as np
@@ -348,3 +349,95 @@ def test_online_step_equals_the_python_online_estimator(lib, method, heading, gy
     worst = _assert_same_run(python, NativeOnline(lib, **config).run(*stream), str(config))
     assert not python[0][:3].any() and python[0][3:600].all() and not python[0][600:605].any()
     print(f"largest difference {worst:.2g}")
+
+
+@pytest.mark.parametrize("config", [
+    dict(method="kalman"),
+    dict(params={"tau_heading": 5.0}),  # the heading stage does not run
+    dict(method="mahony", params={"delta_n": 0.001}, gyro_offset=False),
+    dict(method="tseng", params={"k_P": 1.0}, heading=True),
+    dict(params={"delta_n": -1.0}),
+    dict(params={"delta_n": math.inf}),
+    dict(params={"stationary": 0.5}),
+    dict(params={"rest_time": 0.0}),
+    dict(params={"mag_cal_time": -1.0, "tau_heading": 1e-320}, heading=True),
+    dict(method="luinge", params={"tilt_sd": -math.inf}, heading=True, gyro_offset=False),
+    dict(gyr_samples="points"),
+    dict(acc_samples="avg"),
+    dict(latency=0.6),
+    dict(latency=math.nan),
+])
+def test_the_online_estimator_refuses_what_python_refuses_with_its_message(lib, config):
+    with pytest.raises(ValueError) as python:
+        OnlineEstimator(**config)
+    with pytest.raises(ValueError) as native:
+        NativeOnline(lib, **config)
+    assert str(native.value) == str(python.value)
+
+
+def test_a_sample_time_or_a_design_python_refuses_at_the_first_step_is_refused_alike(lib):
+    """A bad Ts is refused by the step (in C, and by the discretisation a model asks for at
+    initialisation); a design Python refuses at its first step (eq. 33 for omega_c below
+    omega_g/√2) the C core refuses at configuration already, with the same message."""
+    stream = [np.zeros((1, 3)), np.array([[0.0, 0.0, 9.81]]), np.full((1, 3), np.nan)]
+    for Ts in (0.0, -0.01, math.nan, math.inf):
+        with pytest.raises(ValueError) as python:
+            OnlineEstimator().step(stream[0][0], stream[1][0], Ts)
+        with pytest.raises(ValueError) as native:
+            NativeOnline(lib).run(*stream, [Ts])
+        assert str(native.value) == str(python.value)
+    with pytest.raises(ValueError) as python:
+        OnlineEstimator(params={"omega_c": 0.05}).step(stream[0][0], stream[1][0], 0.01)
+    with pytest.raises(ValueError) as native:
+        NativeOnline(lib, params={"omega_c": 0.05})
+    assert str(native.value) == str(python.value)
+
+
+@pytest.mark.parametrize("config, stage", [
+    (dict(params={"delta_n": 1e300}), "method 'wiener'"),
+    (dict(method="tseng", params={"sigma_motion": 1e200}), "the gyro-offset estimator"),
+    (dict(method="tseng", params={"mag_new_time": 1e307}, heading=True, gyro_offset=False), "the heading estimator"),
+])
+def test_parameters_whose_coefficients_overflow_are_refused_at_the_discretisation(lib, config, stage):
+    """Python's step raises OverflowError (or runs on infinite coefficients); the C core refuses
+    the discretisation with a message naming the stage, the sample time and the overflow, and
+    steps nothing."""
+    with pytest.raises(ValueError, match=rf"^{stage} at Ts = 0.01 s: its coefficients overflow"):
+        NativeOnline(lib, **config).run(np.zeros((1, 3)), [[0.0, 0.0, 9.81]], np.full((1, 3), np.nan), [0.01])
+
+
+def test_a_copy_of_the_estimator_continues_as_the_original_and_a_reset_starts_afresh(lib):
+    """AfOnline is plain data: a byte copy taken midway (an FMU state) continues exactly as the
+    original; after af_online_reset the estimator runs as a fresh one, its discretisation kept."""
+    gyr, acc, mag, Ts = _human_stream()
+    config = dict(method="tseng_adaptive", params=_stage_params(True, True), heading=True, gyr_samples="point")
+    est = NativeOnline(lib, **config)
+    est.run(gyr[:700], acc[:700], mag[:700], Ts[:700])
+    copy = NativeOnline(lib, **config)
+    ctypes.memmove(copy.est, est.est, lib.online_size())
+    rest = (gyr[700:], acc[700:], mag[700:], Ts[700:])
+    status, out = est.run(*rest)
+    c_status, c_out = copy.run(*rest)
+    assert np.array_equal(status, c_status) and np.array_equal(out, c_out)
+    lib.af_online_reset.argtypes = [ctypes.c_void_p]
+    lib.af_online_reset(est.est)
+    _assert_same_run(NativeOnline(lib, **config).run(gyr, acc, mag, Ts), est.run(gyr, acc, mag, Ts), "after a reset")
+
+
+BROAD = Path(os.environ.get("BROAD_DIR", Path(__file__).resolve().parents[1].parent / "shared" / "broad"))
+BROAD_RECORDING = BROAD / "32_disturbed_attached_magnet_1cm.mat"  # rest, fast turns, a magnet attached
+
+
+@pytest.mark.skipif(not BROAD_RECORDING.exists(), reason=f"no BROAD recording {BROAD_RECORDING}")
+@pytest.mark.parametrize("config", [dict(heading=True), dict(method="luinge", gyro_offset=False, latency=0.003),
+                                    dict(method="tseng", heading=True, gyr_samples="point", acc_samples="mean")])
+def test_online_step_equals_the_python_online_estimator_on_a_broad_recording(lib, config):
+    """The first 40 s of a real recording (285.7 Hz) with the stages' default parameters."""
+    from attitude_fmu.systems.recordings.reading import read_recording
+
+    rec = read_recording(BROAD_RECORDING)
+    n = int(40.0 * rec.fs)
+    stream = (rec.gyr[:n], rec.acc[:n], rec.mag[:n], np.full(n, 1.0 / rec.fs))
+    python = _python_run(OnlineEstimator(**config), *stream)
+    worst = _assert_same_run(python, NativeOnline(lib, **config).run(*stream), f"{BROAD_RECORDING.name} {config}")
+    print(f"{config}: largest difference {worst:.2g}")
