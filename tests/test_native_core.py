@@ -6,6 +6,7 @@ of bad parameters with Python's messages, and every method's step, state by stat
 hard motion with the sample time changed midway."""
 import ctypes
 import math
+import os
 
 import control
 import numpy as np
@@ -19,9 +20,9 @@ from attitude_fmu.blocks.methods import luinge, mahony, registry, tseng_adaptive
 from attitude_fmu.blocks.params import resolve_params
 from attitude_fmu.blocks.quaternion import quat_multiply, quat_normalized, rotvec_quat, up_in_sensor
 from attitude_fmu.blocks.stages import timing
+from attitude_fmu.fmu_src.variables import tuning_parameters
 from attitude_fmu.systems.fmi.native_tables import stages
-from attitude_fmu.fmu_src.AttitudeEstimator import tuning_parameters
-from tests.native import CORE, core_library
+from tests.native import CORE, SANITIZE, core_library, sanitized_pytest
 
 TUNING = list(tuning_parameters())  # af_params.h's order
 STAGES = stages()
@@ -144,10 +145,10 @@ def _vector(values) -> np.ndarray:
     return vector
 
 
-def _python_error(call):
-    """The message of the ValueError (or OverflowError) call raises, or None."""
+def _python_error(function, *args):
+    """The message of the ValueError (or OverflowError) function(*args) raises, or None."""
     try:
-        call()
+        function(*args)
     except (ValueError, OverflowError) as exc:
         return str(exc)
     return None
@@ -201,12 +202,12 @@ def test_float_repr_of_random_values_is_pythons(lib):
 
 @pytest.mark.parametrize("stage", range(len(STAGES)), ids=[s[0] for s in STAGES])
 def test_resolve_params_refuses_as_python(lib, stage):
-    name, owner, _, params = STAGES[stage]
+    _, owner, _, params = STAGES[stage]
     resolved = np.empty(len(TUNING))
     cases = [{p.name: v} for p in params for v in (-1.0, 0.0, 2.5, 1e300, math.inf, -math.inf)]
     cases.append({next(t for t in TUNING if t not in {p.name for p in params}): 1.0})  # a name the stage lacks
     for given in cases:
-        expected = _python_error(lambda: resolve_params(params, given, owner))
+        expected = _python_error(resolve_params, params, given, owner)
         message = _message()
         status = lib.resolve_params(stage, _vector(given), resolved, message, len(message))
         assert (status, message.value.decode() if status else None) == (-1 if expected else 0, expected), given
@@ -219,7 +220,7 @@ def test_resolve_params_refuses_as_python(lib, stage):
 def test_method_refusals_are_pythons(lib):
     message = _message()
     assert lib.method_index(b"kalman", message, len(message)) == -1
-    assert message.value.decode() == _python_error(lambda: registry.method("kalman"))
+    assert message.value.decode() == _python_error(registry.method, "kalman")
     assert [lib.method_index(n.encode(), message, len(message)) for n in registry.METHODS] == list(range(6))
     m = AfMethod()
     for name, given in (("wiener", {"stationary": 0.5}), ("wiener", {"omega_c": 0.05}),
@@ -227,7 +228,7 @@ def test_method_refusals_are_pythons(lib):
                         ("wiener", {"delta_n": 1e300, "delta_v": 1e-300})):
         status = lib.method_configure(ctypes.byref(m), lib.method_index(name.encode(), None, 0), _vector(given),
                                       message, len(message))
-        expected = _python_error(lambda: registry.stepper(name, tuple(sorted(given.items())), 0.01))
+        expected = _python_error(registry.stepper, name, tuple(sorted(given.items())), 0.01)
         assert status == -1 and message.value.decode() == expected, (name, given)
 
 
@@ -237,7 +238,7 @@ def test_overflowing_parameters_are_refused_with_a_message(lib, name, given):
     """Python fails on these too (OverflowError, or a filter that does not exist); the C core
     refuses them at configuration or at the first discretisation, naming the values."""
     m, s, message = AfMethod(), AfStepper(), _message()
-    assert _python_error(lambda: registry.stepper(name, tuple(sorted(given.items())), 0.01)) is not None
+    assert _python_error(registry.stepper, name, tuple(sorted(given.items())), 0.01) is not None
     status = lib.method_configure(ctypes.byref(m), lib.method_index(name.encode(), None, 0), _vector(given),
                                   message, len(message))
     if status == 0:
@@ -254,7 +255,7 @@ def test_the_sample_time_is_refused_as_python_refuses_it(lib):
                                     message, len(message)) == 0
         for Ts in (0.0, -0.01, math.inf, math.nan):
             assert lib.stepper_at(ctypes.byref(s), ctypes.byref(m), Ts, message, len(message)) == -1
-            assert message.value.decode() == _python_error(lambda: registry.stepper(name, (), Ts))
+            assert message.value.decode() == _python_error(registry.stepper, name, (), Ts)
 
 
 # ---- filters: realisation, zero-order hold, matrix functions
@@ -325,9 +326,8 @@ def test_band_pass_variance_closed_form_is_the_integral(lib):
     """J = (1/2π)∫ (ωτ_v)⁴/(1+ω²τ_v²)²/(1+ω²/ω_m²) dω (wiener_local.coefficients integrates it with quad)."""
     for omega_m in (0.05, 0.5, 1.0, 3.0, 10.0, 40.0, 500.0):
         for tau_v in (0.1, 1.0, 3.0):
-            c = omega_m * tau_v
-            value, error = quad(lambda x: x**4 / ((1.0 + x * x) ** 2 * (1.0 + (x / c) ** 2)), 0.0, np.inf,
-                                epsabs=0.0, epsrel=1e-13, limit=200)
+            value = quad(lambda x, c: x**4 / ((1.0 + x * x) ** 2 * (1.0 + (x / c) ** 2)), 0.0, np.inf,
+                         args=(omega_m * tau_v,), epsabs=0.0, epsrel=1e-13, limit=200)[0]
             assert lib.band_pass_variance(omega_m, tau_v) == pytest.approx(value / (2.0 * math.pi * tau_v), rel=1e-12)
 
 
@@ -440,11 +440,11 @@ def test_timing_is_pythons(lib):
         for Ts in (reference, reference * (1 + 5e-10), reference * (1 + 2e-9), reference * (1 - 2e-9), 2 * reference):
             assert bool(lib.same_step(Ts, reference)) == timing.same_step(Ts, reference)
     for latency in (0.0, 0.5, -0.5, 0.02, 0.5000001, -3.0, math.inf, math.nan):
-        expected = _python_error(lambda: timing.check_latency(latency))
+        expected = _python_error(timing.check_latency, latency)
         status = lib.check_latency(latency, message, len(message))
         assert (status, message.value.decode() if status else None) == (-1 if expected else 0, expected)
     for gyr_samples, acc_samples in (("mean", "point"), ("point", "mean"), ("average", "point"), ("mean", "")):
-        expected = _python_error(lambda: timing.check_samples(gyr_samples, acc_samples))
+        expected = _python_error(timing.check_samples, gyr_samples, acc_samples)
         status = lib.check_samples(gyr_samples.encode(), acc_samples.encode(), message, len(message))
         assert (status, message.value.decode() if status else None) == (-1 if expected else 0, expected)
     rng = np.random.default_rng(11)
@@ -475,3 +475,16 @@ def test_start_gravity_and_level_on_are_pythons(lib):
         q = np.empty(4)
         lib.level_on(np.ascontiguousarray(acc0), q)
         np.testing.assert_allclose(q, mahony.level_on(acc0), rtol=0, atol=1e-15)
+
+
+# ---- the same, built with the sanitizers
+
+@pytest.mark.skipif(bool(os.environ.get(SANITIZE)), reason="this is the sanitized run")
+def test_the_core_runs_clean_under_the_sanitizers():
+    """This file's tests again on the core built with -fsanitize=address,undefined: any
+    out-of-bounds access, use of uninitialised stack or undefined behaviour fails them."""
+    run = sanitized_pytest(__file__, "-x")
+    if run is None:
+        pytest.skip("the C compiler names no address-sanitizer runtime")
+    assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
+    assert "runtime error" not in run.stderr and "Sanitizer" not in run.stderr, run.stderr[-3000:]
