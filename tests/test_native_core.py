@@ -5,8 +5,10 @@ python-control's ss and c2d, the closed form of wiener_local's J against quad, t
 of bad parameters with Python's messages, and every method's step, state by state, over
 hard motion with the sample time changed midway."""
 import ctypes
+import importlib
 import math
 import os
+import re
 
 import control
 import numpy as np
@@ -256,6 +258,46 @@ def test_the_sample_time_is_refused_as_python_refuses_it(lib):
         for Ts in (0.0, -0.01, math.inf, math.nan):
             assert lib.stepper_at(ctypes.byref(s), ctypes.byref(m), Ts, message, len(message)) == -1
             assert message.value.decode() == _python_error(registry.stepper, name, (), Ts)
+
+
+TWIN = re.compile(r"Python twin: (blocks/[\w/]+)\.py")
+DEFINE = re.compile(r"^#define (\w+) ([-+]?[0-9][0-9.eE+-]*)\b", re.M)
+
+
+def _python_constant(module, name):
+    """The number module holds under name, or under name without the module's prefix
+    (WIENER_LOCAL_W2 → wiener_local.W2; a slice: its start; STATE_SIZE: len(STATE_NAMES)); None."""
+    for candidate in (name, name.removeprefix(module.__name__.rsplit(".", 1)[1].upper() + "_")):
+        if candidate == "STATE_SIZE" and hasattr(module, "STATE_NAMES"):
+            return len(module.STATE_NAMES)
+        value = getattr(module, candidate, None)
+        if isinstance(value, slice):
+            return value.start
+        if isinstance(value, (int, float)) and not isinstance(value, bool):
+            return value
+    return None
+
+
+def test_the_constants_of_every_header_are_its_python_twins():
+    """Every numeric #define of a core header whose Python twin has the name equals it."""
+    checked = set()
+    for header in sorted(CORE.rglob("*.h")):
+        text = header.read_text()
+        twin = TWIN.search(text)
+        if twin is None:
+            continue
+        module = importlib.import_module("attitude_fmu." + twin.group(1).replace("/", "."))
+        for name, literal in DEFINE.findall(text):
+            value = _python_constant(module, name)
+            if value is not None:
+                assert float(literal) == value, f"{header.relative_to(CORE)}: {name} = {literal}, Python {value!r}"
+                checked.add(name)
+    assert {"STEP_TOLERANCE", "MAX_LATENCY_S", "NOMINAL_DELTA_V", "STANDARD_GRAVITY", "SERIES_ANGLE2",
+            "WIENER_LOCAL_STATE_SIZE", "WIENER_LOCAL_W2", "WIENER_LOCAL_T", "WIENER_LOCAL_QUAT",
+            "LUINGE_STATE_SIZE", "MAHONY_STATE_SIZE"} <= checked, checked
+    defines = dict(DEFINE.findall((CORE / "filters" / "earth_filters.h").read_text()))
+    assert float(defines["SQRT2"]) == math.sqrt(2.0) == wiener_local.SQRT2
+    assert int(defines["MAX_ORDER"]) == MAX_ORDER == len(tseng.earth_filter().den_array[0, 0]) - 1  # the largest
 
 
 # ---- filters: realisation, zero-order hold, matrix functions

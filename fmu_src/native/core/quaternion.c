@@ -93,13 +93,23 @@ Vec3 up_in_sensor(Quat q)
     return quat_rotate(quat_conjugate(q), (Vec3){0.0, 0.0, 1.0});
 }
 
+Quat quat_load(const double q[4])
+{
+    return (Quat){q[0], q[1], q[2], q[3]};
+}
+
+void quat_store(Quat q, double out[4])
+{
+    out[0] = q.w;
+    out[1] = q.x;
+    out[2] = q.y;
+    out[3] = q.z;
+}
+
 void write_sample(double gravity[3], double quat[4], double g, Vec3 up, const double q[4])
 {
     gravity[0] = g * up.x;
     gravity[1] = g * up.y;
     gravity[2] = g * up.z;
-    quat[0] = q[0];
-    quat[1] = q[1];
-    quat[2] = q[2];
-    quat[3] = q[3];
+    quat_store(quat_load(q), quat);
 }

@@ -17,6 +17,8 @@ Quat level_quat(Vec3 u, double norm);                    /* smallest rotation of
 Vec3 quat_euler_zyx(Quat q);                             /* roll, pitch, yaw (rad) of the Z-Y-X sequence */
 Vec3 up_in_sensor(Quat q);                               /* earth up in sensor coordinates: R(q)^T z */
 Quat quat_conjugate(Quat q);                             /* the inverse of a unit quaternion */
+Quat quat_load(const double q[4]);                       /* the quaternion a state array holds in q[0..3] */
+void quat_store(Quat q, double out[4]);                  /* q into a state array's out[0..3] */
 /* a kernel method's output for one sample: gravity g up (m/s^2, g the magnitude) and quat = q */
 void write_sample(double gravity[3], double quat[4], double g, Vec3 up, const double q[4]);
 

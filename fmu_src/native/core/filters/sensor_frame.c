@@ -88,14 +88,10 @@ void filter_rows(double *X, const double *Xr, const double acc[3], int n, const 
 void level_onto_gravity(double q[4], Quat dq, const double g[3])
 {
     double g0 = g[0], g1 = g[1], g2 = g[2];
-    Quat qt = quat_multiply((Quat){q[0], q[1], q[2], q[3]}, dq);
+    Quat qt = quat_multiply(quat_load(q), dq);
     double norm = sqrt(g0 * g0 + g1 * g1 + g2 * g2);
     if (norm > 0.0) qt = quat_multiply(level_quat(quat_rotate(qt, (Vec3){g0, g1, g2}), norm), qt);
-    qt = quat_normalized(qt);
-    q[0] = qt.w;
-    q[1] = qt.x;
-    q[2] = qt.y;
-    q[3] = qt.z;
+    quat_store(quat_normalized(qt), q);
 }
 
 void sensor_frame_step(double *X, double q[4], const double gyr[3], const double acc[3], int n, const double *Ad,

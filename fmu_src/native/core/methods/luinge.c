@@ -22,8 +22,7 @@ void luinge_initial_state(const double coef[LUINGE_COEF_SIZE], const double acc0
 Vec3 luinge_step(double state[LUINGE_STATE_SIZE], double Q, double R, double Ts, const double gyr[3],
                  const double acc[3])
 {
-    Quat q = quat_multiply((Quat){state[0], state[1], state[2], state[3]},
-                           rotvec_quat(gyr[0] * Ts, gyr[1] * Ts, gyr[2] * Ts));
+    Quat q = quat_multiply(quat_load(state), rotvec_quat(gyr[0] * Ts, gyr[1] * Ts, gyr[2] * Ts));
     double a0 = acc[0], a1 = acc[1], a2 = acc[2];
     double norm = sqrt(a0 * a0 + a1 * a1 + a2 * a2);
     if (norm > 0.0) {
@@ -38,10 +37,7 @@ Vec3 luinge_step(double state[LUINGE_STATE_SIZE], double Q, double R, double Ts,
         q = quat_multiply(rotvec_quat(k0 * z0, k1 * z1, 0.0), q);
     }
     q = quat_normalized(q);
-    state[0] = q.w;
-    state[1] = q.x;
-    state[2] = q.y;
-    state[3] = q.z;
+    quat_store(q, state);
     return up_in_sensor(q);
 }
 

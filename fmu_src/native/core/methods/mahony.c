@@ -39,7 +39,7 @@ void level_on(const double acc0[3], double q[4])
 Vec3 mahony_step(double state[MAHONY_STATE_SIZE], double k_P, double k_I, double Ts, const double gyr[3],
                  const double acc[3])
 {
-    Quat q = {state[0], state[1], state[2], state[3]};
+    Quat q = quat_load(state);
     Vec3 v_hat = up_in_sensor(q);
     double a0 = acc[0], a1 = acc[1], a2 = acc[2];
     double norm = sqrt(a0 * a0 + a1 * a1 + a2 * a2);
@@ -57,10 +57,7 @@ Vec3 mahony_step(double state[MAHONY_STATE_SIZE], double k_P, double k_I, double
     w1 = gyr[1] - state[5] + k_P * e1;
     w2 = gyr[2] - state[6] + k_P * e2;
     q = quat_normalized(quat_multiply(q, rotvec_quat(w0 * Ts, w1 * Ts, w2 * Ts)));
-    state[0] = q.w;
-    state[1] = q.x;
-    state[2] = q.y;
-    state[3] = q.z;
+    quat_store(q, state);
     return up_in_sensor(q);
 }
 

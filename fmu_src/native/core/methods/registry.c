@@ -172,30 +172,34 @@ int stepper_at(AfStepper *s, const AfMethod *m, double Ts, char *message, size_t
                   text);
 }
 
+/* the kernels' own steps (KernelStepper): initial_state(coef, gravity, state) and run */
+static const struct {
+    void (*initial_state)(const double *coef, const double *gravity, double *state);
+    void (*run)(double *state, const double *coef, const double *gyr, const double *acc, double *gravity,
+                double *quat);
+} KERNELS[] = {
+    [KERNEL_WIENER_LOCAL] = {wiener_local_initial_state, wiener_local_run},
+    [KERNEL_TSENG_ADAPTIVE] = {tseng_adaptive_initial_state, tseng_adaptive_run},
+    [KERNEL_LUINGE] = {luinge_initial_state, luinge_run},
+    [KERNEL_MAHONY] = {mahony_initial_state, mahony_run},
+};
+
 void stepper_initial_state(const AfStepper *s, const double gravity[3], double *state)
 {
-    switch (s->kernel) {
-    case KERNEL_NONE: sensor_frame_initial_state(&s->disc, gravity, state); break;
-    case KERNEL_WIENER_LOCAL: wiener_local_initial_state(s->coef, gravity, state); break;
-    case KERNEL_TSENG_ADAPTIVE: tseng_adaptive_initial_state(s->coef, gravity, state); break;
-    case KERNEL_LUINGE: luinge_initial_state(s->coef, gravity, state); break;
-    default: mahony_initial_state(s->coef, gravity, state);
-    }
+    if (s->kernel == KERNEL_NONE)
+        sensor_frame_initial_state(&s->disc, gravity, state);
+    else
+        KERNELS[s->kernel].initial_state(s->coef, gravity, state);
 }
 
 void stepper_run(const AfStepper *s, double *state, const double gyr[3], const double acc[3], double gravity[3],
                  double quat[4])
 {
     const DiscreteFilter *d = &s->disc;
-    int i;
-    switch (s->kernel) {
-    case KERNEL_NONE:
-        sensor_frame_step(state, state + 3 * d->n, gyr, acc, d->n, d->Ad, d->Bd, d->C, d->D, d->Ts, gravity);
-        for (i = 0; i < 4; i++) quat[i] = state[3 * d->n + i];
-        break;
-    case KERNEL_WIENER_LOCAL: wiener_local_run(state, s->coef, gyr, acc, gravity, quat); break;
-    case KERNEL_TSENG_ADAPTIVE: tseng_adaptive_run(state, s->coef, gyr, acc, gravity, quat); break;
-    case KERNEL_LUINGE: luinge_run(state, s->coef, gyr, acc, gravity, quat); break;
-    default: mahony_run(state, s->coef, gyr, acc, gravity, quat);
+    if (s->kernel != KERNEL_NONE) {
+        KERNELS[s->kernel].run(state, s->coef, gyr, acc, gravity, quat);
+        return;
     }
+    sensor_frame_step(state, state + 3 * d->n, gyr, acc, d->n, d->Ad, d->Bd, d->C, d->D, d->Ts, gravity);
+    quat_store(quat_load(state + 3 * d->n), quat);
 }
