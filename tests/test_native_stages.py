@@ -15,11 +15,10 @@ from attitude_fmu.blocks.methods.registry import METHODS
 from attitude_fmu.blocks.pipeline.online import OnlineEstimator
 from attitude_fmu.blocks.quaternion import integrate_rates
 from attitude_fmu.blocks.stages import gyro_offset, heading
-from attitude_fmu.fmu_src.AttitudeEstimator import tuning_parameters
-from attitude_fmu.systems.fmi.native_tables import write_headers
+from attitude_fmu.fmu_src.variables import tuning_parameters
 from attitude_fmu.systems.simulation.motion import EARTH_FIELD_UT, ClosedFormMotion, HumanMotion
 from attitude_fmu.systems.simulation.sensor_model import ImuModel
-from tests.native import CORE, core_library
+from tests.native import CORE, SANITIZE, core_library, sanitized_pytest
 
 FS = 100.0
 TUNING = list(tuning_parameters())  # the parameters in af_params.h's order
@@ -33,8 +32,7 @@ STATE_RTOL = 1e-11
 def lib(tmp_path_factory):
     """The whole C core with tests/native_online.c, the online estimator's loop over arrays."""
     folder = tmp_path_factory.mktemp("native_core")
-    lib = core_library(folder, [*sorted(CORE.rglob("*.c")), Path(__file__).with_name("native_online.c")],
-                       include=[write_headers(folder).parent])
+    lib = core_library(folder, [*sorted(CORE.rglob("*.c")), Path(__file__).with_name("native_online.c")])
     lib.online_size.restype = ctypes.c_size_t
     lib.online_init.argtypes = [ctypes.c_void_p, ctypes.c_char_p, _DOUBLES, ctypes.c_int, ctypes.c_int,
                                 ctypes.c_double, ctypes.c_char_p, ctypes.c_char_p, ctypes.c_char_p, ctypes.c_size_t]
@@ -42,6 +40,14 @@ def lib(tmp_path_factory):
                                _DOUBLES, ctypes.c_char_p, ctypes.c_size_t]
     lib.online_run.restype = ctypes.c_size_t
     return lib
+
+
+class Quat(ctypes.Structure):
+    _fields_ = [(c, ctypes.c_double) for c in "wxyz"]  # quaternion.h's Quat
+
+
+class Vec3(ctypes.Structure):
+    _fields_ = [(c, ctypes.c_double) for c in "xyz"]  # quaternion.h's Vec3
 
 
 _DOUBLES = np.ctypeslib.ndpointer(np.float64, flags="C_CONTIGUOUS")
@@ -214,7 +220,9 @@ def test_heading_step_equals_its_python_twin(lib, stream):
     make, fs = STREAMS[stream]
     quat, mag, params = make()
     coef = heading.coefficients(heading.resolve(params), 1.0 / fs)
-    run = _doubles(lib, "heading_run", "ddndddidd")
+    step = lib.heading_step
+    step.argtypes = [_DOUBLES, _DOUBLES, Quat, Vec3, ctypes.POINTER(ctypes.c_int)]
+    step.restype = Quat
     state = heading.initial_state()
     c_state = np.full_like(state, np.nan)
     _doubles(lib, "heading_initial_state", "d")(c_state)
@@ -222,17 +230,20 @@ def test_heading_step_equals_its_python_twin(lib, stream):
     n = len(quat)
     states, c_states = np.empty((n, len(state))), np.empty((n, len(state)))
     out, c_out = np.empty((n, 4)), np.empty((n, 4))
-    accepted, c_accepted = np.empty(n, dtype=np.bool_), np.empty(n, dtype=np.intc)
+    accepted, c_accepted, ok = np.empty(n, dtype=np.bool_), np.empty(n, dtype=bool), ctypes.c_int()
     offset, c_offset, delay, c_delay = np.empty((n, 3)), np.empty((n, 3)), np.empty(n), np.empty(n)
     for k in range(n):
         c_state[:] = state  # the same state in
         heading.run(state, coef, quat[k:k + 1], mag[k:k + 1], out[k:k + 1], accepted[k:k + 1], offset[k:k + 1],
                     delay[k:k + 1])
-        run(c_state, coef, 1, quat[k], mag[k], c_out[k], c_accepted[k:k + 1], c_offset[k], c_delay[k:k + 1])
+        turned = step(c_state, coef, Quat(*quat[k]), Vec3(*mag[k]), ctypes.byref(ok))
+        c_out[k], c_accepted[k] = (turned.w, turned.x, turned.y, turned.z), ok.value
+        c_offset[k], c_delay[k] = c_state[heading.HARD_IRON_OFFSET:heading.HARD_IRON_OFFSET + 3], \
+            c_state[heading.MAG_DELAY_IN_USE]
         states[k], c_states[k] = state, c_state
     worst = max(_close(states, c_states, "states", STATE_RTOL), _close(out, c_out, "orientation"),
                 _close(offset, c_offset, "hard-iron offset"), _close(delay, c_delay, "delay"))
-    assert np.array_equal(accepted, c_accepted.astype(bool))
+    assert np.array_equal(accepted, c_accepted)
     used = np.abs(offset).sum(axis=1) > 0
     fields = np.isfinite(mag).all(axis=1)
     restarts = np.flatnonzero((states[1:, 3] == 1.0) & (states[:-1, 3] > 1.0)) + 1  # SEEN back to 1: started afresh
@@ -441,3 +452,17 @@ def test_online_step_equals_the_python_online_estimator_on_a_broad_recording(lib
     python = _python_run(OnlineEstimator(**config), *stream)
     worst = _assert_same_run(python, NativeOnline(lib, **config).run(*stream), f"{BROAD_RECORDING.name} {config}")
     print(f"{config}: largest difference {worst:.2g}")
+
+
+# ---- the same, built with the sanitizers
+
+@pytest.mark.skipif(bool(os.environ.get(SANITIZE)), reason="this is the sanitized run")
+def test_the_stages_and_the_pipeline_run_clean_under_the_sanitizers():
+    """This file's tests again (of the online comparisons, one method's: the pipeline's paths
+    are the same for all) on the core built with -fsanitize=address,undefined: any
+    out-of-bounds access or undefined behaviour fails them."""
+    run = sanitized_pytest(__file__, "-x", "-k", "not online_step_equals_the_python_online_estimator or tseng_adaptive")
+    if run is None:
+        pytest.skip("the C compiler names no address-sanitizer runtime")
+    assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
+    assert "runtime error" not in run.stderr and "Sanitizer" not in run.stderr, run.stderr[-3000:]

@@ -250,10 +250,3 @@ void gyro_offset_step(double state[GYRO_OFFSET_STATE_SIZE], const double coef[GY
         variance[i] = P[4 * i];
     }
 }
-
-void gyro_offset_run(double state[GYRO_OFFSET_STATE_SIZE], const double coef[GYRO_OFFSET_COEF_SIZE], size_t n,
-                     const double *gyr, const double *acc, double *offset, double *variance)
-{
-    for (size_t k = 0; k < n; k++)
-        gyro_offset_step(state, coef, gyr + 3 * k, acc + 3 * k, offset + 3 * k, variance + 3 * k);
-}

@@ -3,8 +3,6 @@
 #ifndef AF_GYRO_OFFSET_H
 #define AF_GYRO_OFFSET_H
 
-#include <stddef.h>
-
 #include "af_params.h"
 
 #define GYRO_OFFSET_STATE_SIZE 60 /* len(STATE_NAMES) */
@@ -19,12 +17,8 @@ void gyro_offset_coefficients(const double params[AF_N_PARAMS], double Ts, doubl
 void gyro_offset_initial_state(const double coef[GYRO_OFFSET_COEF_SIZE], const double gyr0[3], const double acc0[3],
                                double state[GYRO_OFFSET_STATE_SIZE]);
 
-/* One sample of run: state in place; the offset estimate after it (rad/s) and its variance per axis ((rad/s)^2). */
+/* One sample of run (gyr rad/s, acc m/s^2): state in place; the offset estimate after it (rad/s) and its variance per axis ((rad/s)^2). */
 void gyro_offset_step(double state[GYRO_OFFSET_STATE_SIZE], const double coef[GYRO_OFFSET_COEF_SIZE],
                       const double gyr[3], const double acc[3], double offset[3], double variance[3]);
-
-/* run: gyro_offset_step over n rows of gyr, acc (n x 3, row-major) into offset, variance (n x 3). */
-void gyro_offset_run(double state[GYRO_OFFSET_STATE_SIZE], const double coef[GYRO_OFFSET_COEF_SIZE], size_t n,
-                     const double *gyr, const double *acc, double *offset, double *variance);
 
 #endif

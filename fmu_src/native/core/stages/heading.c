@@ -180,17 +180,3 @@ Quat heading_step(double state[HEADING_STATE_SIZE], const double coef[HEADING_CO
         state[0] = atan2(sin(state[0]), cos(state[0]));
     return about_up(state[0], q);
 }
-
-void heading_run(double state[HEADING_STATE_SIZE], const double coef[HEADING_COEF_SIZE], size_t n, const double *quat,
-                 const double *mag, double *out, int *accepted, double *offset, double *delay)
-{
-    for (size_t k = 0; k < n; k++) {
-        const double *q = quat + 4 * k, *m = mag + 3 * k;
-        Quat turned = heading_step(state, coef, (Quat){q[0], q[1], q[2], q[3]}, (Vec3){m[0], m[1], m[2]},
-                                   accepted + k);
-        out[4 * k] = turned.w, out[4 * k + 1] = turned.x, out[4 * k + 2] = turned.y, out[4 * k + 3] = turned.z;
-        for (int i = 0; i < 3; i++)
-            offset[3 * k + i] = state[HARD_IRON_OFFSET + i];
-        delay[k] = state[MAG_DELAY_IN_USE];
-    }
-}

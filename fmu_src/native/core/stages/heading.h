@@ -3,8 +3,6 @@
 #ifndef AF_HEADING_H
 #define AF_HEADING_H
 
-#include <stddef.h>
-
 #include "af_params.h"
 #include "quaternion.h"
 #include "stages/hard_iron.h"
@@ -31,10 +29,5 @@ void heading_initial_state(double state[HEADING_STATE_SIZE]);
  * *ok: whether the field m_sensor (a NaN: no sample this step) was used. state in place. */
 Quat heading_step(double state[HEADING_STATE_SIZE], const double coef[HEADING_COEF_SIZE], Quat q, Vec3 m_sensor,
                   int *ok);
-
-/* run: heading_step over n rows: quat (n x 4), mag (n x 3) into out (n x 4), accepted (n), offset
- * (n x 3, the hard-iron estimate) and delay (n, s), row-major. */
-void heading_run(double state[HEADING_STATE_SIZE], const double coef[HEADING_COEF_SIZE], size_t n, const double *quat,
-                 const double *mag, double *out, int *accepted, double *offset, double *delay);
 
 #endif
