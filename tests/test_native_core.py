@@ -98,6 +98,7 @@ SIGNATURES = {  # name: (restype, argtypes)
     "start_gravity": (None, [ARRAY, ARRAY, ctypes.c_double, ARRAY]),
     "level_on": (None, [ARRAY, ARRAY]),
     "band_pass_variance": (ctypes.c_double, [ctypes.c_double, ctypes.c_double]),
+    "butterworth_zoh": (None, [ctypes.c_double, ARRAY, ARRAY]),
     "method_index": (ctypes.c_int, [ctypes.c_char_p, ctypes.c_char_p, ctypes.c_size_t]),
     "method_configure": (ctypes.c_int, [ctypes.POINTER(AfMethod), ctypes.c_int, ARRAY, ctypes.c_char_p,
                                         ctypes.c_size_t]),
@@ -346,6 +347,23 @@ def test_the_zero_order_hold_is_c2d(lib, name, given):
             np.abs(exact).max()
         assert np.abs(X.reshape(n, 3) - exact).max() <= tolerance
         assert np.abs(python.rest_state(acc0) - exact).max() <= tolerance
+
+
+def test_the_local_wieners_zero_order_hold_is_pythons_and_c2d(lib):
+    """wiener_local's closed form for d/dt[ĝ, u] = ω_g·M·[ĝ, u] + ω_g·[0, 1]·y_a, M = [[0, 1], [−1, −√2]]."""
+    M = np.array([[0.0, 1.0], [-1.0, -math.sqrt(2.0)]])
+    for wg in (0.05, 0.13, 1.0, 7.0):
+        for Ts in (1e-4, 0.01, 0.04, 0.3):
+            Ad, Bd = np.empty(4), np.empty(2)
+            lib.butterworth_zoh(wg * Ts, Ad, Bd)
+            Ad_py, Bd_py = np.empty((2, 2)), np.empty(2)
+            wiener_local.butterworth_zoh(wg * Ts, Ad_py, Bd_py)
+            np.testing.assert_allclose(Ad.reshape(2, 2), Ad_py, rtol=0, atol=4e-16)  # numba's fast-math: an ulp
+            np.testing.assert_allclose(Bd, Bd_py, rtol=0, atol=4e-16)
+            # within rounding of the state it updates (the closed form's Bd[0] cancels where ω_g·Ts is tiny)
+            disc = control.c2d(control.ss(wg * M, wg * np.array([[0.0], [1.0]]), np.eye(2), 0.0), Ts, "zoh")
+            np.testing.assert_allclose(Ad.reshape(2, 2), disc.A, rtol=0, atol=1e-14)
+            np.testing.assert_allclose(Bd, disc.B.ravel(), rtol=0, atol=1e-14)
 
 
 def test_expm_and_solve_are_scipys_and_numpys(lib):
