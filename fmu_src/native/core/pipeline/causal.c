@@ -172,21 +172,20 @@ void causal_run(const AfPipeline *pipeline, const AfStep *step, AfState *state, 
     }
     stepper_run(&step->stepper, state->method, gyr, acc, out->gravity, out->quat);
     if (pipeline->heading_runs) {
-        const double *q = out->quat;
-        Quat turned = heading_step(state->heading, step->heading_coef, (Quat){q[0], q[1], q[2], q[3]},
+        Quat turned = heading_step(state->heading, step->heading_coef, quat_load(out->quat),
                                    (Vec3){mag[0], mag[1], mag[2]}, &out->mag_accepted);
-        out->quat[0] = turned.w, out->quat[1] = turned.x, out->quat[2] = turned.y, out->quat[3] = turned.z;
+        quat_store(turned, out->quat);
         for (int i = 0; i < 3; i++)
             out->mag_offset[i] = state->heading[HARD_IRON_OFFSET + i];
         out->mag_delay = state->heading[MAG_DELAY_IN_USE];
     }
     if (pipeline->latency != 0.0) {
-        const double *q = out->quat, *g = out->gravity;
+        const double *g = out->gravity;
         Quat carried;
         Vec3 up;
-        carry_forward((Quat){q[0], q[1], q[2], q[3]}, (Vec3){g[0], g[1], g[2]}, (Vec3){gyr[0], gyr[1], gyr[2]},
+        carry_forward(quat_load(out->quat), (Vec3){g[0], g[1], g[2]}, (Vec3){gyr[0], gyr[1], gyr[2]},
                       pipeline->latency, &carried, &up);
-        out->quat[0] = carried.w, out->quat[1] = carried.x, out->quat[2] = carried.y, out->quat[3] = carried.z;
+        quat_store(carried, out->quat);
         out->gravity[0] = up.x, out->gravity[1] = up.y, out->gravity[2] = up.z;
     }
 }

@@ -66,7 +66,7 @@ int af_online_step(AfOnline *est, const double gyr[3], const double acc[3], cons
         est->mag_offset[i] = est->state.heading[HARD_IRON_OFFSET + i];
     }
     est->mag_delay = est->state.heading[MAG_DELAY_IN_USE];
-    Vec3 euler = quat_euler_zyx((Quat){est->quat[0], est->quat[1], est->quat[2], est->quat[3]});
+    Vec3 euler = quat_euler_zyx(quat_load(est->quat));
     est->euler[0] = euler.x, est->euler[1] = euler.y, est->euler[2] = euler.z;
     return 1;
 }

@@ -211,9 +211,9 @@ void gyro_offset_step(double state[GYRO_OFFSET_STATE_SIZE], const double coef[GY
     double old[3] = {acc_lp[0], acc_lp[1], acc_lp[2]};
     if (V > 0.0) { /* tracking while moving: the gyro frame and its low-passes */
         Quat q = quat_normalized(quat_multiply( /* turned by the corrected gyro */
-            (Quat){state[QUAT], state[QUAT + 1], state[QUAT + 2], state[QUAT + 3]},
+            quat_load(state + QUAT),
             rotvec_quat((gyr[0] - b[0]) * Ts, (gyr[1] - b[1]) * Ts, (gyr[2] - b[2]) * Ts)));
-        state[QUAT] = q.w, state[QUAT + 1] = q.x, state[QUAT + 2] = q.y, state[QUAT + 3] = q.z;
+        quat_store(q, state + QUAT);
         state[T] += Ts;
         /* the accelerometer, R.b and R (row-major) low-passed */
         double R[9], a[3], rb[3];

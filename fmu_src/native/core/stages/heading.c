@@ -72,7 +72,7 @@ static int new_reference(double *state, const double *coef, Quat q, double norm,
     }
     state[CAND_NORM] = norm, state[CAND_DIP] = dip, state[CAND_N] = 1.0, state[CAND_DOT] = 1.0;
     state[CAND_START] = state[STEPS];
-    state[CAND_Q0] = q.w, state[CAND_Q0 + 1] = q.x, state[CAND_Q0 + 2] = q.y, state[CAND_Q0 + 3] = q.z;
+    quat_store(q, state + CAND_Q0);
     return 0;
 }
 
@@ -149,7 +149,7 @@ Quat heading_step(double state[HEADING_STATE_SIZE], const double coef[HEADING_CO
     if (!online)
         state[MAG_DELAY_IN_USE] = coef[9];
     const double *delay_coef = coef + MAG_DELAY_COEF;
-    Quat q_prev = {state[Q_PREV], state[Q_PREV + 1], state[Q_PREV + 2], state[Q_PREV + 3]};
+    Quat q_prev = quat_load(state + Q_PREV);
     Vec3 turn = {0.0, 0.0, 0.0}; /* the last step's rotation (rad), wanted online or for a given delay */
     if ((online || coef[9] != 0.0) && fabs(q_prev.w) + fabs(q_prev.x) + fabs(q_prev.y) + fabs(q_prev.z) > 0.0)
         turn = step_turn(q_prev, q);
@@ -175,7 +175,7 @@ Quat heading_step(double state[HEADING_STATE_SIZE], const double coef[HEADING_CO
             mag_delay_field_sample(state + MAG_DELAY, delay_coef, m_sensor, rate, *ok);
         }
     }
-    state[Q_PREV] = q.w, state[Q_PREV + 1] = q.x, state[Q_PREV + 2] = q.y, state[Q_PREV + 3] = q.z;
+    quat_store(q, state + Q_PREV);
     if (fabs(state[0]) > PI)
         state[0] = atan2(sin(state[0]), cos(state[0]));
     return about_up(state[0], q);
