@@ -224,6 +224,8 @@ def test_method_refusals_are_pythons(lib):
     message = _message()
     assert lib.method_index(b"kalman", message, len(message)) == -1
     assert message.value.decode() == _python_error(registry.method, "kalman")
+    assert lib.method_index(None, message, len(message)) == -1
+    assert message.value.decode() == _python_error(registry.method, None)
     assert [lib.method_index(n.encode(), message, len(message)) for n in registry.METHODS] == list(range(6))
     m = AfMethod()
     for name, given in (("wiener", {"stationary": 0.5}), ("wiener", {"omega_c": 0.05}),

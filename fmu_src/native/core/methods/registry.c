@@ -25,13 +25,14 @@ int method_index(const char *name, char *message, size_t size)
 {
     char available[256] = "", text[128];
     int i;
-    for (i = 0; i < AF_N_METHODS; i++)
+    for (i = 0; name != NULL && i < AF_N_METHODS; i++)
         if (strcmp(name, AF_STAGES[i].name) == 0) return i;
     for (i = 0; i < AF_N_METHODS; i++) {
         if (i > 0) strcat(available, ", ");
         strcat(available, AF_STAGES[i].name);
     }
-    return refuse(message, size, "unknown method %s; available: %s", str_repr(name, text, sizeof text), available);
+    return refuse(message, size, "unknown method %s; available: %s",
+                  name != NULL ? str_repr(name, text, sizeof text) : "None", available);
 }
 
 /* design_delta_v and _omega_g: the break frequency of the stationary filter */

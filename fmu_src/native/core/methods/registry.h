@@ -40,7 +40,7 @@ typedef struct {
 } AfStepper;
 
 /* method(name): the index AF_STAGE_<name> of a method, or -1 with Python's message
- * "unknown method 'x'; available: wiener, tseng, ...". */
+ * "unknown method 'x'; available: wiener, tseng, ..." (name NULL: Python's None). */
 int method_index(const char *name, char *message, size_t size);
 
 /* The method of index with the values given: resolved (Method.resolve: blocks/params.py's
