@@ -5,10 +5,12 @@ python-control's ss and c2d, the closed form of wiener_local's J against quad, t
 of bad parameters with Python's messages, and every method's step, state by state, over
 hard motion with the sample time changed midway."""
 import ctypes
+import dataclasses
 import importlib
 import math
 import os
 import re
+import subprocess
 
 import control
 import numpy as np
@@ -19,12 +21,13 @@ from scipy.integrate import quad
 from attitude_fmu.blocks.filters import tseng
 from attitude_fmu.blocks.filters.sensor_frame import DiscreteFilter, start_gravity
 from attitude_fmu.blocks.methods import luinge, mahony, registry, tseng_adaptive, wiener_local
-from attitude_fmu.blocks.params import resolve_params
+from attitude_fmu.blocks.params import Param, resolve_params
 from attitude_fmu.blocks.quaternion import quat_multiply, quat_normalized, rotvec_quat, up_in_sensor
 from attitude_fmu.blocks.stages import timing
 from attitude_fmu.fmu_src.variables import tuning_parameters
+from attitude_fmu.systems.fmi import native_tables
 from attitude_fmu.systems.fmi.native_tables import stages
-from tests.native import CORE, SANITIZE, core_library, sanitized_pytest
+from tests.native import CORE, SANITIZE, compiler, core_library, sanitized_pytest
 
 TUNING = list(tuning_parameters())  # af_params.h's order
 STAGES = stages()
@@ -187,6 +190,26 @@ def test_the_generated_tables_are_the_python_ones(lib):
         np.testing.assert_array_equal(c, python)
 
 
+def test_a_field_param_grows_is_carried_into_the_header(tmp_path, monkeypatch):
+    """A field added to blocks.params.Param (here a range's upper end) appears in AfStageParam
+    with every stage's value, without a change to the generator."""
+    @dataclasses.dataclass(frozen=True)
+    class RangedParam(Param):
+        high: float | None = None
+
+    ranged = [(name, owner, label, tuple(RangedParam(**dataclasses.asdict(p), high=2.0 * (i + 1))
+                                         for i, p in enumerate(ps))) for name, owner, label, ps in STAGES]
+    monkeypatch.setattr(native_tables, "Param", RangedParam)
+    monkeypatch.setattr(native_tables, "stages", lambda: ranged)
+    (tmp_path / "af_params.h").write_text(native_tables.header_text())
+    (tmp_path / "use.c").write_text('#include "af_params.h"\n'
+                                     "double luinge_tilt_high(void) { return AF_STAGE_PARAMS_luinge[1].high; }\n")
+    subprocess.run([*compiler(), "-std=c99", "-Wall", "-Wextra", "-Werror", "-fsyntax-only", f"-I{tmp_path}",
+                    str(tmp_path / "use.c")], check=True)
+    assert "{AF_P_tilt_sd, \"tilt_sd\", 0.05, \"rad\", " in (tmp_path / "af_params.h").read_text()
+    assert ", 0, 4.0}," in (tmp_path / "af_params.h").read_text()  # luinge's second parameter: allow_zero, high
+
+
 @pytest.mark.parametrize("value", [0.0, -0.0, 1.0, -1.5, 0.1, 0.01, 1e-4, 1e-5, 1.5e-5, 123.456, 100.0, 1e15, 1e16,
                                    123456789012345678.0, 2.5e300, 1e300, 5e-324, 1.7976931348623157e308,
                                    math.radians(0.1), 1 / 3, math.inf, -math.inf, math.nan])
@@ -264,7 +287,7 @@ def test_the_sample_time_is_refused_as_python_refuses_it(lib):
 
 
 TWIN = re.compile(r"Python twin: (blocks/[\w/]+)\.py")
-DEFINE = re.compile(r"^#define (\w+) ([-+]?[0-9][0-9.eE+-]*)\b", re.M)
+DEFINE = re.compile(r"^#define (\w+) ([-+]?[0-9][0-9.eE+-]*)\b", re.MULTILINE)
 
 
 def _python_constant(module, name):

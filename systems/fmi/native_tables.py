@@ -77,7 +77,8 @@ def _param_fields() -> list[tuple[str, str, str]]:
     """(Python name, C name, Python type) of every field of blocks.params.Param."""
     fields = []
     for field in dataclasses.fields(Param):
-        type_name = field.type if isinstance(field.type, str) else field.type.__name__
+        # a string where the annotations are postponed; else the type itself ("float | None" as str())
+        type_name = field.type if isinstance(field.type, str) else getattr(field.type, "__name__", str(field.type))
         if type_name not in C_TYPES:
             raise ValueError(f"Param.{field.name}: no C type for {type_name!r} (native_tables.C_TYPES)")
         fields.append((field.name, field.name + "_value" if field.name in C_KEYWORDS else field.name, type_name))
