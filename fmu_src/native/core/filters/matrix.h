@@ -13,7 +13,8 @@
 void solve(int n, double *A, int m, double *B);
 
 /* E = exp(M) by scaling and squaring with a diagonal Pade approximant of degree 3 to 13
- * (Higham 2005, the algorithm of scipy.linalg.expm); M and E n x n, distinct. */
+ * chosen by the 1-norm of M (Higham 2005; scipy.linalg.expm refines the choice from norms of
+ * powers of M, Al-Mohy and Higham 2009: the two agree to rounding); M and E n x n, distinct. */
 void expm(int n, const double *M, double *E);
 
 #endif
