@@ -3,7 +3,7 @@
  *
  * One command a line; each FMI call prints "<command> <status>" on stdout, the logger's messages
  * go to stderr as "[<status> <category>] <message>". Commands:
- *   load BINARY                   dlopen the FMU's shared library and find its functions
+ *   load BINARY                   dlopen the FMU's shared library (the rest of the line) and find its functions
  *   instantiate GUID URI LOGGING  fmi2Instantiate (co-simulation; LOGGING 0 or 1)
  *   setup | enter | exit | terminate | reset | free
  *   real VR VALUE | string VR TEXT | boolean VR 0|1      one fmi2Set* (TEXT without spaces)
@@ -178,6 +178,11 @@ int main(int argc, char **argv) {
     char line[8192];
     int ok = 1;
     while (ok && fgets(line, sizeof line, script)) {
+        char path[sizeof line];
+        if (strncmp(line, "load ", 5) == 0) { /* a path may hold spaces */
+            strcpy(path, line + 5);
+            path[strcspn(path, "\r\n")] = '\0';
+        }
         char *tokens[3 * MAX_VRS + 8];
         size_t n = 0;
         for (char *t = strtok(line, " \t\r\n"); t && n < sizeof tokens / sizeof *tokens; t = strtok(NULL, " \t\r\n"))
@@ -187,8 +192,8 @@ int main(int argc, char **argv) {
         char **args = tokens + 1;
         size_t nargs = n - 1;
         int status = -1;
-        if (strcmp(command, "load") == 0 && nargs == 1) {
-            ok = load(&fmu, args[0]);
+        if (strcmp(command, "load") == 0 && nargs >= 1) {
+            ok = load(&fmu, path);
             continue;
         } else if (!fmu.library) {
             ok = 0;
