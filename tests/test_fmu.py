@@ -667,6 +667,8 @@ def test_verify_cli_json_contract_and_exit_status(fmu_dir, monkeypatch, capsys):
     assert {"profile", "method", "rms_deg", "bound_deg", "pass"} <= set(row)
     assert row["profile"] == "incline" and row["method"] == "wiener" and row["pass"]
     assert row["mean_deg"] < 0.05
+    # the native estimator FMU ran beside the pythonfmu one on the same signals
+    assert row["native_max_diff"] < 1e-9 and row["native_valid_equal"]
     # a bound that cannot be met fails the run
     monkeypatch.setattr(verify_module, "BIAS_BOUND_DEG", -1.0)
     assert main(args) == 1
