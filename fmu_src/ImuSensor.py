@@ -14,8 +14,8 @@ import math
 import numpy as np
 
 from attitude_fmu.blocks.stages.timing import same_step
-from attitude_fmu.fmu_src.fmu_support import IN, INTEGER, OUT, PAR, ProjectSlave
-from attitude_fmu.systems.simulation.motion import EARTH_FIELD_UT
+from attitude_fmu.fmu_src.fmu_support import ProjectSlave
+from attitude_fmu.fmu_src.simulation_variables import imu_sensor
 from attitude_fmu.systems.simulation.noise import MAGNETOMETER, SENSOR, NoiseStream
 from attitude_fmu.systems.simulation.sensor_model import ImuModel
 
@@ -28,23 +28,7 @@ class ImuSensor(ProjectSlave):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        self.vector("omega", (0.0, 0.0, 0.0), "rad/s", "true angular rate {c}, mean over the step", IN)
-        self.vector("f", (0.0, 0.0, 9.81), "m/s2", "true specific force {c}", IN)
-        self.vector("m", EARTH_FIELD_UT, "uT", "true magnetic field {c}", IN)
-        self.vector("gyr", (0.0, 0.0, 0.0), "rad/s", "measured angular rate {c}", OUT)
-        self.vector("acc", (0.0, 0.0, 9.81), "m/s2", "measured specific force {c}", OUT)
-        self.vector("mag", EARTH_FIELD_UT, "uT", "measured magnetic field {c}", OUT)
-        self.real("delta_n", 0.0, "rad/s/sqrt(Hz)", "gyro white-noise density, one-sided", PAR)
-        self.vector("gyr_offset", (0.0, 0.0, 0.0), "rad/s", "constant gyro offset {c}", PAR)
-        for row in "xyz":
-            self.vector(f"gyr_scale_{row}", (0.0, 0.0, 0.0), "1",
-                        f"gyro scale and misalignment error: share of the true rate's {{c}} in gyr_{row}", PAR)
-        self.real("acc_noise", 0.0, "m/s2/sqrt(Hz)", "accelerometer white-noise density, one-sided", PAR)
-        self.vector("acc_offset", (0.0, 0.0, 0.0), "m/s2", "constant accelerometer offset {c}", PAR)
-        self.real("latency", 0.0, "s", "how long gyr and acc lag the motion (a fixed step needed)", PAR)
-        self.real("mag_noise", 0.0, "uT/sqrt(Hz)", "magnetometer white-noise density, one-sided", PAR)
-        self.vector("mag_offset", (0.0, 0.0, 0.0), "uT", "hard iron: a field {c} fixed to the sensor", PAR)
-        self.parameter("seed", 1, "seed of the noise generator", INTEGER)
+        self.register_table(imu_sensor())
         self.model = None
 
     def initialise(self):

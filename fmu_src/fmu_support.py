@@ -19,7 +19,7 @@ from pythonfmu import Boolean, Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variab
 from pythonfmu.enums import Fmi2Status
 
 from attitude_fmu.fmu_src.model_description import model_structure, model_variables, unit_definitions
-from attitude_fmu.fmu_src.variables import BOOLEAN, IN, INTEGER, OUT, PAR, REAL, STRING, Table, fmi_unit
+from attitude_fmu.fmu_src.variables import BOOLEAN, INTEGER, REAL, STRING, Table
 
 PACKAGE = "attitude_fmu"  # the modules of it an FMU imports are in its resources, under this name
 INTERNAL_STATE = " internal"  # key of a saved FMU state's model part (no variable name has a space)
@@ -163,18 +163,6 @@ class ProjectSlave(Fmi2Slave):
         """Register every row of another table (an interface of fmu_src.variables)."""
         self.register(self.table.extend_from(rows))
 
-    def real(self, name, start, unit, description, causality):
-        """Register a Real input, output or (fixed) parameter held in attribute `name`."""
-        self.register(self.table.real(name, start, unit, description, causality))
-
-    def vector(self, prefix, start, unit, description, causality, components="xyz"):
-        """Register prefix_<c> for each component c; description may use {c}."""
-        self.register(self.table.vector(prefix, start, unit, description, causality, components))
-
-    def parameter(self, name, start, description, kind=STRING):
-        """Register a fixed String, Integer or Boolean parameter held in attribute `name`."""
-        self.register(self.table.parameter(name, start, description, kind))
-
     error = None  # the message of an invalid configuration or of foreign code, once one was found
 
     def fail(self, message: str) -> bool:
@@ -196,4 +184,4 @@ class ProjectSlave(Fmi2Slave):
 
 _PYTHONFMU_TYPES = {REAL: Real, INTEGER: Integer, BOOLEAN: Boolean, STRING: String}
 
-__all__ = ["ProjectSlave", "Fmi2Status", "INTEGER", "IN", "OUT", "PAR", "fmi_unit"]
+__all__ = ["ProjectSlave", "Fmi2Status"]

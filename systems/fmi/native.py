@@ -11,6 +11,8 @@ two can take each other's place. The guid is a digest of everything the FMU is b
 from, so an FMU built from other sources is told apart (is_current).
 
     DIR/native/AttitudeEstimator.fmu    by python build_fmu.py (systems.fmi.build.build_fmus)
+    DIR/native/ImuSensor.fmu            the sensor model and the motions, in C from the simulation's
+    DIR/native/MotionProfile.fmu        twins (fmu_src/native/sim), the same interfaces as the pythonfmu ones
     NoOpEstimator.fmu                   AttitudeEstimator's interface, nothing behind it: the benchmark's baseline
 """
 from __future__ import annotations
@@ -33,6 +35,7 @@ import fmpy
 
 import attitude_fmu
 from attitude_fmu.fmu_src.model_description import LOG_CATEGORIES, model_description, model_variables
+from attitude_fmu.fmu_src.simulation_variables import imu_sensor, motion_profile
 from attitude_fmu.fmu_src.variables import BOOLEAN, INTEGER, OUT, PAR, REAL, STRING, attitude_estimator
 from attitude_fmu.systems.fmi import native_tables
 from attitude_fmu.systems.fmi.native_tables import c_double, c_string
@@ -46,11 +49,13 @@ GUID_NAMESPACE = uuid.UUID("6f0e2a4c-8b1d-4c55-9d3e-2f7a1b9c0d41")  # of the nat
 @dataclass(frozen=True)
 class NativeModel:
     """A native FMU: its interface (a table of fmu_src.variables), its description, and
-    whether its model runs the estimator's C core."""
+    whether its model runs the estimator's C core, or the simulation's twins (fmu_src/native/sim
+    with SIMULATION_CORE, the core's files they use)."""
 
     interface: object
     description: str
     core: bool
+    simulation: bool = False
 
 
 NATIVE_MODELS = {
@@ -58,8 +63,14 @@ NATIVE_MODELS = {
                                      "peers); gravity up, ENU, q sensor->earth; in C, no Python", True),
     "NoOpEstimator": NativeModel(attitude_estimator, "AttitudeEstimator's interface; doStep does nothing "
                                  "(benchmark baseline)", False),
+    "ImuSensor": NativeModel(imu_sensor, "IMU sensor model: gyro noise density, offset, scale and misalignment, "
+                             "accelerometer noise and offset, magnetometer noise and hard iron; in C, no Python",
+                             False, True),
+    "MotionProfile": NativeModel(motion_profile, "Motion profiles with exact truth: ideal gyro, specific force, "
+                                 "magnetic field, orientation; in C, no Python", False, True),
 }
-NATIVE_NAMES = ("AttitudeEstimator",)  # what build_fmus builds into DIR/native
+NATIVE_NAMES = ("AttitudeEstimator", "ImuSensor", "MotionProfile")  # what build_fmus builds into DIR/native
+SIMULATION_CORE = ("quaternion", "messages", "stages/timing")  # the core's files fmu_src/native/sim uses
 
 
 class CompileError(RuntimeError):
@@ -160,6 +171,10 @@ def _fixed_sources(name: str) -> dict[str, bytes]:
     if NATIVE_MODELS[name].core:
         files.update(_tree_files(NATIVE_DIR / "core"))
         files[native_tables.HEADER] = native_tables.header_text().encode("ascii")
+    if NATIVE_MODELS[name].simulation:
+        files.update({f"{stem}{ext}": (NATIVE_DIR / "core" / f"{stem}{ext}").read_bytes()
+                      for stem in SIMULATION_CORE for ext in (".c", ".h")})
+        files.update(_tree_files(NATIVE_DIR / "sim", "sim/"))
     files.update(_tree_files(NATIVE_DIR / "fmi2", "fmi2/"))
     files[f"models/{name}.c"] = (NATIVE_DIR / "models" / f"{name}.c").read_bytes()
     return files
