@@ -1,4 +1,4 @@
-"""The `attitude` command line: estimate, evaluate, plot, table1, verify, compare, bode, bench."""
+"""The `attitude` command line: estimate, evaluate, plot, table1, verify, ssp, compare, bode, bench."""
 from __future__ import annotations
 
 import argparse
@@ -136,6 +136,14 @@ def _read_options(args) -> dict:
             "gyr_axes": args.gyr_axes, "acc_axes": args.acc_axes, "mag_axes": args.mag_axes}
 
 
+def _add_verify_flags(parser) -> None:
+    parser.add_argument("--fmu-dir", default="dist", help="where the FMUs are, built there if missing or built from "
+                        "other sources (default dist/)")
+    parser.add_argument("--rebuild", action="store_true", help="build the FMUs even if present")
+    parser.add_argument("--profile", action="append", help="only this profile (repeatable)")
+    parser.add_argument("--method", action="append", help="only this method (repeatable)")
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="attitude", description="IMU attitude estimators (Rizun's optimal Wiener filter and peers).",
@@ -198,10 +206,16 @@ def build_parser() -> argparse.ArgumentParser:
 
     vf = sub.add_parser("verify", help="co-simulate every profile with every estimator as FMUs; exit 1 if a bound is missed")
     vf.add_argument("--json", action="store_true")
-    vf.add_argument("--fmu-dir", default="dist", help="where the FMUs are, built there if missing or built from other sources (default dist/)")
-    vf.add_argument("--rebuild", action="store_true", help="build the FMUs even if present")
-    vf.add_argument("--profile", action="append", help="only this profile (repeatable)")
-    vf.add_argument("--method", action="append", help="only this method (repeatable)")
+    _add_verify_flags(vf)
+    vf.add_argument("--python", action="store_true", help="also run the pythonfmu chain and hold its estimator "
+                    "outputs to the native chain's within 1e-9 (minutes instead of seconds)")
+    ss = sub.add_parser("ssp", help="write verify's SSP of each profile × method, the FMUs inside, for other tools")
+    ss.add_argument("--out", type=Path, required=True, help="folder for the files <profile>_<method>.ssp")
+    _add_verify_flags(ss)
+    chain = ss.add_mutually_exclusive_group()
+    chain.add_argument("--native", dest="chain", action="store_const", const="native", default="native",
+                       help="the FMUs in C (DIR/native; default)")
+    chain.add_argument("--python", dest="chain", action="store_const", const="python", help="the pythonfmu FMUs")
 
     cp = sub.add_parser("compare", help="every estimator and the peers vqf, madgwick on every motion profile")
     cp.add_argument("--profile", action="append", help="only this profile (repeatable)")
@@ -426,18 +440,32 @@ def cmd_table1(args) -> int:
     return 0
 
 
-def cmd_verify(args) -> int:
+def _verified_fmus(args) -> Path:
+    """The FMU folder, built where needed, once the profiles and methods asked for are known."""
     from attitude_fmu.systems.fmi.build import ensure_built
-    from attitude_fmu.systems.fmi.verify import SCENARIOS, verify
-    from attitude_fmu.systems.simulation.motion import PROFILES
+    from attitude_fmu.systems.fmi.verify import SCENARIOS
 
     for name in args.profile or []:
         if name not in SCENARIOS:
             raise ValueError(f"unknown profile {name!r}; verified profiles: {', '.join(SCENARIOS)}")
     for name in args.method or []:
         known_method(name)  # refuses unknown names
-    fmu_dir = ensure_built(args.fmu_dir, args.rebuild, log=lambda m: print(f"attitude: {m}", file=sys.stderr))
-    rows = verify(fmu_dir, args.profile, args.method)
+    return ensure_built(args.fmu_dir, args.rebuild, log=lambda m: print(f"attitude: {m}", file=sys.stderr))
+
+
+def cmd_ssp(args) -> int:
+    from attitude_fmu.systems.fmi.verify import write_verify_ssps
+
+    for path in write_verify_ssps(_verified_fmus(args), args.out, args.profile, args.method, args.chain):
+        print(path)
+    return 0
+
+
+def cmd_verify(args) -> int:
+    from attitude_fmu.systems.fmi.verify import verify
+    from attitude_fmu.systems.simulation.motion import PROFILES
+
+    rows = verify(_verified_fmus(args), args.profile, args.method, python=args.python)
     if args.json:
         print(json.dumps({"rows": rows}, indent=2))
     else:
@@ -451,8 +479,8 @@ def cmd_verify(args) -> int:
             print(f"{r['profile']:>15} {r['method']:>14} {r['rms_deg']:8.3g} {r['max_deg']:8.3g} {r['mean_deg']:9.3g}"
                   f"  {bound} {r['metric']:>4}  {result:<6}  {native}")
         print("profiles: " + "; ".join(f"{n}: {PROFILES[n].summary}" for n in dict.fromkeys(r["profile"] for r in rows)))
-        print("native Δ: the largest difference between the outputs of the native estimator FMU (in C) and the "
-              "pythonfmu one, side by side in the co-simulation (— without a native FMU)")
+        print(f"chain: {rows[0]['chain'] if rows else '—'}; native Δ: the largest difference between the estimator "
+              "outputs of the native chain (FMUs in C) and the pythonfmu one, with the same seeds (— without --python)")
     failed = [r for r in rows if not r["pass"]]
     if failed:
         print(f"attitude: {len(failed)} of {len(rows)} rows missed their bound", file=sys.stderr)
@@ -525,7 +553,7 @@ def cmd_bench(args) -> int:
 
 def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
-    handler = {"estimate": cmd_estimate, "evaluate": cmd_evaluate, "plot": cmd_plot, "table1": cmd_table1, "verify": cmd_verify, "compare": cmd_compare,
+    handler = {"estimate": cmd_estimate, "evaluate": cmd_evaluate, "plot": cmd_plot, "table1": cmd_table1, "verify": cmd_verify, "ssp": cmd_ssp, "compare": cmd_compare,
                "bode": cmd_bode, "bench": cmd_bench}[args.command]
     try:
         if hasattr(args, "latency"):
