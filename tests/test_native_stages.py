@@ -64,7 +64,8 @@ def _doubles(lib, name, count):
 
 
 def _param_vector(values) -> np.ndarray:
-    """values (name → value; None: unset) as the C core's parameter array (af_params.h's AF_P_<name> order), NaN elsewhere."""
+    """values (name → value; None: unset) as the C core's parameter array (af_params.h's
+    AF_P_<name> order), NaN elsewhere."""
     vector = np.full(len(TUNING), np.nan)
     for name, value in values.items():
         vector[TUNING.index(name)] = math.nan if value is None else value
@@ -72,7 +73,8 @@ def _param_vector(values) -> np.ndarray:
 
 
 def _close(python, c, what, rtol=OUTPUT_RTOL):
-    """python and c (step × values) equal within rtol of each column's scale (its largest magnitude, at least 1e-300)."""
+    """python and c (step × values) equal within rtol of each column's scale (its largest
+    magnitude, at least 1e-300)."""
     python, c = np.asarray(python, dtype=float), np.asarray(c, dtype=float)
     scale = np.maximum(np.nanmax(np.abs(python), axis=0, keepdims=True), 1e-300) if python.ndim > 1 else \
         max(np.nanmax(np.abs(python)), 1e-300)
@@ -108,7 +110,7 @@ def _rests_and_motion():
         motion = HumanMotion(delta_v=0.5 if moving else 1e-12, rot_rms=1.0 if moving else 0.0).generate(
             duration, FS, seed=10 + k)
         parts.append(imu.apply(motion, seed=20 + k))
-    return np.ascontiguousarray(np.vstack([p[0] for p in parts])), np.ascontiguousarray(np.vstack([p[1] for p in parts]))
+    return tuple(np.ascontiguousarray(np.vstack([p[i] for p in parts])) for i in (0, 1))
 
 
 @pytest.mark.parametrize("params", [{}, {"tau_motion": 0.0}, {"delta_n": math.radians(0.3), "rest_time": 0.5}])
@@ -147,7 +149,8 @@ def test_gyro_offset_step_equals_its_python_twin(lib, params):
 # ---- heading, hard iron and the magnetometer's delay
 
 def _gyro_quat(gyr):
-    """The orientation integrated from the gyro (sensor → earth, from the identity): heading drifts with its offset."""
+    """The orientation integrated from the gyro (sensor → earth, from the identity): its
+    heading drifts with the gyro's offset."""
     quat = np.empty((len(gyr), 4))
     integrate_rates(np.ascontiguousarray(gyr), 1.0 / FS, quat)
     return quat

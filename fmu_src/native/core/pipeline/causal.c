@@ -82,10 +82,11 @@ int causal_configure(AfPipeline *pipeline, const char *method, const double para
         return -1;
     pipeline->offset_runs = gyro_offset != 0;
     pipeline->heading_runs = heading != 0;
-    if (pipeline->offset_runs &&
-        resolve_params(AF_STAGE_gyro_offset, offset_given, pipeline->offset_params, message, size))
+    if (pipeline->offset_runs && resolve_params(AF_STAGE_gyro_offset, offset_given, pipeline->offset_params, message,
+                                                size))
         return -1;
-    if (pipeline->heading_runs && resolve_params(AF_STAGE_heading, heading_given, pipeline->heading_params, message, size))
+    if (pipeline->heading_runs && resolve_params(AF_STAGE_heading, heading_given, pipeline->heading_params, message,
+                                                 size))
         return -1;
     if (check_samples(gyr_samples, acc_samples, message, size) || check_latency(latency, message, size))
         return -1;
@@ -95,13 +96,19 @@ int causal_configure(AfPipeline *pipeline, const char *method, const double para
     return 0;
 }
 
-/* whether the n values from first are finite; unset: a NaN there stands for a value not given */
-static int finite_from(const double *values, int first, int n, int unset)
+/* whether the n coefficients are finite; a NaN at index unset stands for a value not given */
+static int finite_coefficients(const double *coef, int n, int unset)
 {
-    for (int i = first; i < n; i++)
-        if (!isfinite(values[i]) && !(i == unset && isnan(values[i])))
+    for (int i = 0; i < n; i++)
+        if (!isfinite(coef[i]) && !(i == unset && isnan(coef[i])))
             return 0;
     return 1;
+}
+
+/* the refusal of a stage whose coefficients overflow at Ts (the method's is the registry's) */
+static int overflow(int stage, double Ts, char *message, size_t size)
+{
+    return refuse(message, size, "%s at Ts = %g s: its coefficients overflow", AF_STAGES[stage].owner, Ts);
 }
 
 int causal_at(const AfPipeline *pipeline, double Ts, AfStep *step, char *message, size_t size)
@@ -115,14 +122,13 @@ int causal_at(const AfPipeline *pipeline, double Ts, AfStep *step, char *message
         return -1;
     if (pipeline->offset_runs) {
         gyro_offset_coefficients(pipeline->offset_params, Ts, step->offset_coef);
-        if (!finite_from(step->offset_coef, 0, GYRO_OFFSET_COEF_SIZE, -1))
-            return refuse(message, size, "%s at Ts = %g s: its coefficients overflow", AF_STAGES[AF_STAGE_gyro_offset].owner,
-                          Ts);
+        if (!finite_coefficients(step->offset_coef, GYRO_OFFSET_COEF_SIZE, -1))
+            return overflow(AF_STAGE_gyro_offset, Ts, message, size);
     }
     if (pipeline->heading_runs) {
         heading_coefficients(pipeline->heading_params, Ts, step->heading_coef);
-        if (!finite_from(step->heading_coef, 0, HEADING_COEF_SIZE, 9)) /* coef[9]: mag_delay, NaN when unset */
-            return refuse(message, size, "%s at Ts = %g s: its coefficients overflow", AF_STAGES[AF_STAGE_heading].owner, Ts);
+        if (!finite_coefficients(step->heading_coef, HEADING_COEF_SIZE, 9)) /* coef[9]: mag_delay, NaN when unset */
+            return overflow(AF_STAGE_heading, Ts, message, size);
     }
     return 0;
 }

@@ -52,7 +52,8 @@ void af_online_reset(AfOnline *est);
 int af_online_discretise(AfOnline *est, double Ts, char *message, size_t size);
 
 /* One sample: gyr (rad/s) over the last Ts s, acc (m/s^2) and mag (uT; a NaN or all 0: no field
- * sample; read only where the heading stage runs) now. A Ts within STEP_TOLERANCE of the last one keeps its discretisation.
+ * sample; read only where the heading stage runs) now. A Ts within STEP_TOLERANCE of the last
+ * one keeps its discretisation.
  * 1: taken (the outputs are new); 0: not taken, the estimate held (a gyro or accelerometer
  * value not finite or beyond every IMU's range, valid_sample; or an accelerometer all 0 before
  * the start; a finite gyro point sample still counts as the one before the next);

@@ -17,7 +17,8 @@ void gyro_offset_coefficients(const double params[AF_N_PARAMS], double Ts, doubl
 void gyro_offset_initial_state(const double coef[GYRO_OFFSET_COEF_SIZE], const double gyr0[3], const double acc0[3],
                                double state[GYRO_OFFSET_STATE_SIZE]);
 
-/* One sample of run (gyr rad/s, acc m/s^2): state in place; the offset estimate after it (rad/s) and its variance per axis ((rad/s)^2). */
+/* One sample of run (gyr rad/s, acc m/s^2): state in place; the offset estimate after it
+ * (rad/s) and its variance per axis ((rad/s)^2). */
 void gyro_offset_step(double state[GYRO_OFFSET_STATE_SIZE], const double coef[GYRO_OFFSET_COEF_SIZE],
                       const double gyr[3], const double acc[3], double offset[3], double variance[3]);
 
