@@ -39,16 +39,11 @@ static fmi2Status initialise(Fmi2Instance *instance) {
     p->latency = r[REAL_latency];
     p->mag_noise = r[REAL_mag_noise];
     copy3(p->mag_offset, &r[REAL_mag_offset_x]);
-    if (imu_check(p, message, sizeof message) != 0) {
+    if (imu_check(p, message, sizeof message) != 0 ||
+        check_seed(instance->integers[INTEGER_seed], &model->seed, message, sizeof message) != 0) {
         fmi2_log(instance, fmi2Error, "invalid parameter: %s", message);
         return fmi2Error;
     }
-    if (instance->integers[INTEGER_seed] < 0) {
-        fmi2_log(instance, fmi2Error, "invalid parameter: seed must be a whole number in [0, 2**64), got %d",
-                 instance->integers[INTEGER_seed]);
-        return fmi2Error;
-    }
-    model->seed = (uint64_t)instance->integers[INTEGER_seed];
     model->k = 0;
     return fmi2OK;
 }

@@ -13,6 +13,7 @@
 #include "sim/closed_form.h"
 #include "sim/earth_field.h"
 #include "sim/human_motion.h"
+#include "sim/noise.h"
 
 #define MESSAGE_SIZE 1024
 #define HUMAN N_CLOSED_FORMS /* the profile number of the human motion, after the closed forms */
@@ -74,16 +75,13 @@ static fmi2Status initialise(Fmi2Instance *instance) {
     model->human = profile == HUMAN;
     if (model->human) {
         HumanParams params = {p[0], p[1], p[2], p[3], g};
-        if (human_check(&params, message, sizeof message) != 0) {
+        uint64_t seed;
+        if (human_check(&params, message, sizeof message) != 0 ||
+            check_seed(instance->integers[INTEGER_seed], &seed, message, sizeof message) != 0) {
             fmi2_log(instance, fmi2Error, "invalid parameter: %s", message);
             return fmi2Error;
         }
-        if (instance->integers[INTEGER_seed] < 0) {
-            fmi2_log(instance, fmi2Error, "invalid parameter: seed must be a whole number in [0, 2**64), got %d",
-                     instance->integers[INTEGER_seed]);
-            return fmi2Error;
-        }
-        human_stream_init(&model->stream, &params, (uint64_t)instance->integers[INTEGER_seed]);
+        human_stream_init(&model->stream, &params, seed);
     } else {
         model->closed.profile = (ClosedFormProfile)profile;
         memcpy(model->closed.p, p, sizeof p);

@@ -1,8 +1,10 @@
 /* noise.c: Philox4x64-10 and the Box-Muller transform, the simulations' one random generator.
- * Python twin: systems/simulation/noise.py (philox4x64, _box_muller, _fill). */
+ * Python twin: systems/simulation/noise.py (check_seed, philox4x64, _box_muller, _fill). */
 #include "sim/noise.h"
 
 #include <math.h>
+
+#include "messages.h"
 
 #define M0 UINT64_C(0xD2E7470EE14C6C93) /* Philox4x64's multipliers */
 #define M1 UINT64_C(0xCA5A826395121157)
@@ -20,6 +22,12 @@ static uint64_t mulhilo(uint64_t a, uint64_t b, uint64_t *low) {
     uint64_t cross = (lo_lo >> 32) + (hi_lo & LOW32) + lo_hi;
     *low = a * b;
     return a_hi * b_hi + (hi_lo >> 32) + (cross >> 32);
+}
+
+int check_seed(long long value, uint64_t *seed, char *message, size_t size) {
+    if (value < 0) return refuse(message, size, "seed must be a whole number in [0, 2**64), got %lld", value);
+    *seed = (uint64_t)value;
+    return 0;
 }
 
 void philox4x64(const uint64_t c[4], const uint64_t k[2], uint64_t out[4]) {

@@ -5,6 +5,7 @@
 #ifndef SIM_NOISE_H
 #define SIM_NOISE_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 enum { MOTION = 0, SENSOR = 1, MAGNETOMETER = 2 }; /* the streams (the key's second word) */
@@ -15,6 +16,8 @@ enum { MOTION = 0, SENSOR = 1, MAGNETOMETER = 2 }; /* the streams (the key's sec
 
 /* The Philox4x64-10 block of counter c under key k. */
 void philox4x64(const uint64_t c[4], const uint64_t k[2], uint64_t out[4]);
+/* value as a seed: 0, or -1 with the refusal (check_seed: a whole number in [0, 2**64)). */
+int check_seed(long long value, uint64_t *seed, char *message, size_t size);
 /* The width (<= NOISE_MAX_WIDTH) unit normals of sample k of a stream under seed. */
 void noise_normals(uint64_t seed, uint64_t stream, uint64_t k, int width, double *out);
 
