@@ -129,61 +129,53 @@ int method_configure(AfMethod *m, int index, const double given[AF_N_PARAMS], ch
     return 0;
 }
 
+/* the kernels (KernelStepper): their state and coefficient sizes, initial_state and run */
+static const struct {
+    int state_size, coef_size;
+    void (*initial_state)(const double *coef, const double *gravity, double *state);
+    void (*run)(double *state, const double *coef, const double *gyr, const double *acc, double *gravity,
+                double *quat);
+} KERNELS[] = {
+    [KERNEL_WIENER_LOCAL] = {WIENER_LOCAL_STATE_SIZE, WIENER_LOCAL_COEF_SIZE, wiener_local_initial_state,
+                             wiener_local_run},
+    [KERNEL_TSENG_ADAPTIVE] = {TSENG_ADAPTIVE_STATE_SIZE, TSENG_ADAPTIVE_COEF_SIZE, tseng_adaptive_initial_state,
+                               tseng_adaptive_run},
+    [KERNEL_LUINGE] = {LUINGE_STATE_SIZE, LUINGE_COEF_SIZE, luinge_initial_state, luinge_run},
+    [KERNEL_MAHONY] = {MAHONY_STATE_SIZE, MAHONY_COEF_SIZE, mahony_initial_state, mahony_run},
+};
+
 int stepper_at(AfStepper *s, const AfMethod *m, double Ts, char *message, size_t size)
 {
     char text[512], value[FLOAT_REPR_SIZE];
-    int n_coef = 0, finite;
+    int finite;
     memset(s, 0, sizeof *s);
     s->kernel = m->kernel;
     s->Ts = Ts;
     if (!(isfinite(Ts) && Ts > 0))
         return refuse(message, size, "sample time Ts must be a finite positive number of seconds, got %s",
                       float_repr(Ts, value));
-    switch (m->kernel) {
-    case KERNEL_NONE:
+    if (m->kernel == KERNEL_NONE) {
         if (discrete_filter(&m->filter, Ts, &s->disc, message, size)) return -1;
         s->state_size = SENSOR_FRAME_STATE_SIZE(s->disc.n);
-        break;
-    case KERNEL_WIENER_LOCAL:
-        wiener_local_coefficients(m->params, Ts, s->coef);
-        s->state_size = WIENER_LOCAL_STATE_SIZE;
-        n_coef = WIENER_LOCAL_COEF_SIZE;
-        break;
-    case KERNEL_TSENG_ADAPTIVE:
-        if (tseng_adaptive_coefficients(m->params, Ts, s->coef, message, size)) return -1;
-        s->state_size = TSENG_ADAPTIVE_STATE_SIZE;
-        n_coef = TSENG_ADAPTIVE_COEF_SIZE;
-        break;
-    case KERNEL_LUINGE:
-        luinge_coefficients(m->params, Ts, s->coef);
-        s->state_size = LUINGE_STATE_SIZE;
-        n_coef = LUINGE_COEF_SIZE;
-        break;
-    default: /* KERNEL_MAHONY */
-        mahony_coefficients(m->params, Ts, s->coef);
-        s->state_size = MAHONY_STATE_SIZE;
-        n_coef = MAHONY_COEF_SIZE;
+        finite = finite_values(s->disc.Ad, s->disc.n * s->disc.n) && finite_values(s->disc.Bd, s->disc.n);
+    } else {
+        if (m->kernel == KERNEL_TSENG_ADAPTIVE) {
+            if (tseng_adaptive_coefficients(m->params, Ts, s->coef, message, size)) return -1;
+        } else if (m->kernel == KERNEL_WIENER_LOCAL) {
+            wiener_local_coefficients(m->params, Ts, s->coef);
+        } else if (m->kernel == KERNEL_LUINGE) {
+            luinge_coefficients(m->params, Ts, s->coef);
+        } else {
+            mahony_coefficients(m->params, Ts, s->coef);
+        }
+        s->state_size = KERNELS[m->kernel].state_size;
+        finite = finite_values(s->coef, KERNELS[m->kernel].coef_size);
     }
-    finite = m->kernel == KERNEL_NONE ? finite_values(s->disc.Ad, s->disc.n * s->disc.n) &&
-                                            finite_values(s->disc.Bd, s->disc.n)
-                                      : finite_values(s->coef, n_coef);
     if (finite) return 0;
     params_text(m, text, sizeof text);
     return refuse(message, size, "%s at Ts = %g s: its coefficients overflow (%s)", AF_STAGES[m->method].owner, Ts,
                   text);
 }
-
-/* the kernels' own steps (KernelStepper): initial_state(coef, gravity, state) and run */
-static const struct {
-    void (*initial_state)(const double *coef, const double *gravity, double *state);
-    void (*run)(double *state, const double *coef, const double *gyr, const double *acc, double *gravity,
-                double *quat);
-} KERNELS[] = {
-    [KERNEL_WIENER_LOCAL] = {wiener_local_initial_state, wiener_local_run},
-    [KERNEL_TSENG_ADAPTIVE] = {tseng_adaptive_initial_state, tseng_adaptive_run},
-    [KERNEL_LUINGE] = {luinge_initial_state, luinge_run},
-    [KERNEL_MAHONY] = {mahony_initial_state, mahony_run},
-};
 
 void stepper_initial_state(const AfStepper *s, const double gravity[3], double *state)
 {
