@@ -663,13 +663,13 @@ def test_verify_cli_json_contract_and_exit_status(fmu_dir, monkeypatch, capsys):
     # a short run of one scenario: the full table is the main job (`attitude verify`)
     monkeypatch.setitem(verify_module.SCENARIOS, "incline", verify_module.Scenario(240.0, "mean"))
     args = ["verify", "--json", "--fmu-dir", str(fmu_dir), "--profile", "incline", "--method", "wiener"]
-    assert main(args) == 0
+    assert main([*args, "--python"]) == 0
     (row,) = json.loads(capsys.readouterr().out)["rows"]
     assert {"profile", "method", "rms_deg", "bound_deg", "pass"} <= set(row)
     assert row["profile"] == "incline" and row["method"] == "wiener" and row["pass"]
     assert row["mean_deg"] < 0.05
-    # the native estimator FMU ran beside the pythonfmu one on the same signals
-    assert row["native_max_diff"] < 1e-9 and row["native_valid_equal"]
+    # the native chain ran, and with --python the pythonfmu chain beside it, with the same seeds
+    assert row["chain"] == "native" and row["native_max_diff"] < 1e-9 and row["native_valid_equal"]
     # a bound that cannot be met fails the run
     monkeypatch.setattr(verify_module, "BIAS_BOUND_DEG", -1.0)
     assert main(args) == 1

@@ -5,7 +5,11 @@ writes under libcosim and fmpy's SSP reader, and the master's C stepping loop ag
 Python one."""
 import json
 import math
+import os
 import shutil
+import tempfile
+import zipfile
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -17,15 +21,17 @@ from fmpy.ssp.ssd import read_ssd
 from fmpy.validation import validate_fmu
 
 from attitude_fmu.blocks.methods.registry import METHODS
-from attitude_fmu.systems.fmi import stepping
+from attitude_fmu.systems.fmi import native, stepping
 from attitude_fmu.systems.fmi import verify as verify_module
-from attitude_fmu.systems.fmi.build import build_fmus
+from attitude_fmu.systems.fmi.build import FMU_NAMES, build_fmus
 from attitude_fmu.systems.fmi.cosim import FmuRunner, cosimulate, cosimulate_libcosim, load_slave
 from attitude_fmu.systems.fmi.ssp import write_ssp
 from attitude_fmu.systems.simulation.motion import PROFILES, HumanMotion
 from attitude_fmu.systems.simulation.sensor_model import ImuModel
+from tests.native import SANITIZE, SANITIZERS, sanitized_pytest
 
 FS = 100.0
+SANITIZED = bool(os.environ.get(SANITIZE))  # this is the sanitized run: the native FMUs only
 NATIVE_FMUS = ("native/AttitudeEstimator", "native/ImuSensor", "native/MotionProfile", "native/fmi3/AttitudeEstimator")
 TRUTH = [f"{s}_{a}" for s in ("omega", "f", "m") for a in "xyz"] + [f"qt_{c}" for c in "wxyz"]
 SENSOR_IN = [f"{s}_{a}" for s in ("omega", "f", "m") for a in "xyz"]
@@ -36,9 +42,25 @@ ESTIMATOR_OUT = ["q_w", "q_x", "q_y", "q_z", "g_x", "g_y", "g_z", "roll", "pitch
 
 @pytest.fixture(scope="module")
 def fmu_dir(tmp_path_factory):
+    """Every FMU; in the sanitized run (sanitized_pytest) the native ones alone, their binaries
+    compiled again from their sources/ with the address and undefined-behaviour sanitizers."""
     out = tmp_path_factory.mktemp("fmus")
-    build_fmus(out)
+    build_fmus(out, () if SANITIZED else FMU_NAMES)
+    for name in NATIVE_FMUS if SANITIZED else ():
+        _sanitize(out / f"{name}.fmu")
     return out
+
+
+def _sanitize(fmu: Path) -> None:
+    with tempfile.TemporaryDirectory() as tmp:
+        with zipfile.ZipFile(fmu) as zf:
+            zf.extractall(tmp)
+            names = zf.namelist()
+        binary = next(n for n in names if n.startswith("binaries/"))
+        native.compile_binary(Path(tmp) / "sources", Path(tmp) / binary, ("-Werror", *SANITIZERS))
+        with zipfile.ZipFile(fmu, "w") as zf:
+            for name in names:
+                zf.write(Path(tmp) / name, name)
 
 
 def test_every_native_fmu_validates_and_fmi3_has_the_fmi2_variables(fmu_dir):
@@ -73,7 +95,7 @@ def test_the_motion_fmus_equal_the_batch_motion(fmu_dir, name):
     motion = prof.motion(changed, g=9.79).generate(8.0, FS, seed=5)
     expected = np.hstack([motion.gyr, motion.acc, motion.mag, motion.quat])
     parameters = {"profile": name, "seed": 5, "g": 9.79, **{f"{name}_{k}": v for k, v in changed.items()}}
-    for fmu in ("native/MotionProfile", "MotionProfile"):
+    for fmu in ("native/MotionProfile", *(() if SANITIZED else ("MotionProfile",))):
         got = _run(fmu_dir / f"{fmu}.fmu", parameters, np.empty((len(expected), 0)), [], TRUTH)
         for columns in (slice(0, 3), slice(3, 6), slice(6, 9), slice(9, 13)):
             scale = max(1.0, np.abs(expected[:, columns]).max())
@@ -95,7 +117,7 @@ def test_the_sensor_fmus_equal_imu_model_apply(fmu_dir, latency):
                   "seed": 9, **{f"{v}_{c}": x for v in ("gyr_offset", "acc_offset", "mag_offset")
                                 for c, x in zip("xyz", getattr(imu, v))},
                   **{f"gyr_scale_{r}_{c}": scale[i][j] for i, r in enumerate("xyz") for j, c in enumerate("xyz")}}
-    for fmu in ("native/ImuSensor", "ImuSensor"):
+    for fmu in ("native/ImuSensor", *(() if SANITIZED else ("ImuSensor",))):
         got = _run(fmu_dir / f"{fmu}.fmu", parameters, np.hstack([motion.gyr, motion.acc, motion.mag]), SENSOR_IN,
                    SENSOR_OUT)
         assert np.abs(got - expected).max() < 1e-12 * np.abs(expected).max(), fmu
@@ -267,3 +289,16 @@ def test_the_c_stepping_loop_reports_the_component_that_failed(fmu_dir, tmp_path
     bad = write_ssp(tmp_path / "late.ssp", fmu_dir, {"imu": {"latency": 30.0}}, 1.0, 0.01, chain="native")
     with pytest.raises(RuntimeError, match="component imu failed at t = 0 s"):
         cosimulate(bad, 1.0, 0.01)
+
+
+@pytest.mark.skipif(SANITIZED, reason="this is the sanitized run")
+def test_the_native_fmus_run_clean_under_the_sanitizers():
+    """The native MotionProfile, ImuSensor and the FMI 3.0 estimator's tests again, their binaries
+    built with -fsanitize=address,undefined: any out-of-bounds access or undefined behaviour
+    fails them."""
+    run = sanitized_pytest(__file__, "-x", "-k", "motion_fmus and (human or step_rotation) or sensor_fmus "
+                           "or fmi3_estimator and wiener or reports")
+    if run is None:
+        pytest.skip("the C compiler names no address-sanitizer runtime")
+    assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
+    assert "runtime error" not in run.stderr and "Sanitizer" not in run.stderr, run.stderr[-3000:]

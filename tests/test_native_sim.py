@@ -94,8 +94,9 @@ def test_the_normals_are_box_muller_of_philox_blocks():
     (seed, stream), recomputed here from numpy's Philox and numpy's log, cos and sin."""
     seed, n = 2**40 + 3, 500
     got = noise.normals(seed, noise.SENSOR, n)
-    words = np.array([[np.random.Philox(counter=(k + (j << 64) - 1) % 2**256, key=seed + (noise.SENSOR << 64)).random_raw(4)
-                       for j in range(2)] for k in range(n)]).reshape(n, 8)
+    key = seed + (noise.SENSOR << 64)
+    words = np.array([[np.random.Philox(counter=(k + (j << 64) - 1) % 2**256, key=key).random_raw(4) for j in range(2)]
+                      for k in range(n)]).reshape(n, 8)
     u = ((words >> np.uint64(12)).astype(float) + 0.5) * 2.0**-52
     r, angle = np.sqrt(-2.0 * np.log(u[:, 0::2])), 2.0 * math.pi * u[:, 1::2]
     expected = np.stack([r * np.cos(angle), r * np.sin(angle)], axis=2).reshape(n, 8)[:, :6]

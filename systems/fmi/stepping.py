@@ -1,6 +1,7 @@
 """The co-simulation master's stepping loop in C (systems/fmi/stepping.c), compiled once a process
 with the system's C compiler, for systems.fmi.cosim: with native FMUs a step then costs what the
-FMUs compute, not what a Python loop of FMI calls through ctypes costs (about 20× more)."""
+FMUs compute rather than a Python loop of FMI calls through fmpy (verify's human × wiener, 120 s
+at 50 Hz on the native chain: 0.09 s of CPU against 0.5 s, setup included)."""
 from __future__ import annotations
 
 import ctypes
