@@ -480,7 +480,8 @@ def cmd_verify(args) -> int:
                   f"  {bound} {r['metric']:>4}  {result:<6}  {native}")
         print("profiles: " + "; ".join(f"{n}: {PROFILES[n].summary}" for n in dict.fromkeys(r["profile"] for r in rows)))
         print(f"chain: {rows[0]['chain'] if rows else '—'}; native Δ: the largest difference between the estimator "
-              "outputs of the native chain (FMUs in C) and the pythonfmu one, with the same seeds (— without --python)")
+              "outputs (Euler angles aside) of the native chain (FMUs in C) and the pythonfmu one, with the same "
+              "seeds (— without --python)")
     failed = [r for r in rows if not r["pass"]]
     if failed:
         print(f"attitude: {len(failed)} of {len(rows)} rows missed their bound", file=sys.stderr)

@@ -16,9 +16,9 @@ The chain co-simulated is the native one (DIR/native: MotionProfile, ImuSensor a
 AttitudeEstimator in C) where it is built, else the pythonfmu one (DIR). With --python the
 pythonfmu chain runs every configuration too, with the same seeds: each row then reports the
 largest difference between the two estimators' outputs (native_max_diff, over every Real
-output and step; native_valid_equal: their `valid` agrees at every step), held within
-CHAIN_TOLERANCE. Each configuration runs the SSP `attitude ssp` writes for it
-(write_verify_ssp), as an independent call (verify_one).
+output but the Euler angles, derived from q, and every step; native_valid_equal: their `valid`
+agrees at every step), held within CHAIN_TOLERANCE. Each configuration runs the SSP
+`attitude ssp` writes for it (write_verify_ssp), as an independent call (verify_one).
 """
 from __future__ import annotations
 
@@ -46,6 +46,7 @@ EXACT_BOUND_DEG = 1e-6
 STEP_S = 0.02  # communication step, s
 KERNEL_SETTLE_S = 100.0  # start-up cut for the methods that are not LTI filters, s
 CHAIN_TOLERANCE = 1e-9  # the native and the pythonfmu chain's estimator outputs, with the same seeds
+DERIVED_OUTPUTS = ("estimator.valid", "estimator.roll", "estimator.pitch", "estimator.yaw")  # not held to it
 
 
 @dataclass(frozen=True)
@@ -96,8 +97,11 @@ MOTION_SEED = 3  # the motion's seed in every configuration (the sensor's: the s
 
 def chain_difference(out: dict, other: dict) -> tuple[float, bool]:
     """The largest difference between the estimator's Real outputs in two co-simulations' records
-    (two chains of the same configuration), and whether its `valid` agrees at every step."""
-    names = [k for k in out if k.startswith("estimator.") and k != "estimator.valid"]
+    (two chains of the same configuration), and whether its `valid` agrees at every step. The
+    Euler angles are left out: derived from q, which is compared, they are ill-conditioned at
+    pitch ±90° (step_rotation's last step), where 1e-16 of q turns roll and yaw by up to 2π and
+    pitch by 1e-8."""
+    names = [k for k in out if k.startswith("estimator.") and k not in DERIVED_OUTPUTS]
     diff = max(float(np.abs(out[n] - other[n]).max()) for n in names)
     return diff, bool((out["estimator.valid"] == other["estimator.valid"]).all())
 
