@@ -1,4 +1,5 @@
-"""Build the project's FMUs: python build_fmu.py [--out DIR] (default dist/).
+"""Build the project's FMUs: python build_fmu.py [--out DIR] (default dist/): the pythonfmu
+FMUs into DIR, the native estimator (in C, no Python) into DIR/native.
 
 Run from a clone, it builds from the clone's own sources (this folder is the package
 attitude_fmu); installed, it is attitude_fmu.build_fmu (python -m attitude_fmu.build_fmu).
@@ -25,7 +26,8 @@ def _package():
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(description="Build AttitudeEstimator.fmu, ImuSensor.fmu and MotionProfile.fmu.")
+    parser = argparse.ArgumentParser(description="Build AttitudeEstimator.fmu, ImuSensor.fmu and MotionProfile.fmu "
+                                                 "(pythonfmu) and native/AttitudeEstimator.fmu (in C, no Python).")
     parser.add_argument("--out", type=Path, default=Path("dist"), help="output directory (default dist/)")
     args = parser.parse_args(argv)
     for path in _package().build_fmus(args.out):

@@ -1,9 +1,9 @@
 """ImuSensor.fmu: ideal motion signals in, measured IMU signals out (systems.simulation.sensor_model.ImuModel).
 
-Noise is drawn per step from numpy's generator seeded with `seed`, in the order the
-batch path draws it, so a run equals ImuModel.apply on the same samples; the
-magnetometer's from a stream of its own (mag_noise_generator), as ImuModel.apply_mag
-draws it. With a
+Noise is drawn per step from the noise streams of `seed` (systems.simulation.noise:
+SENSOR for the gyro and accelerometer, MAGNETOMETER for the magnetometer), sample k of
+the run as sample k of the batch path, so a run equals ImuModel.apply and
+ImuModel.apply_mag on the same samples. With a
 `latency`, the measured signals are those of the motion that long ago (ImuModel's delay
 line; before the first step, the motion of the first step), which needs a fixed step.
 """
@@ -14,9 +14,10 @@ import math
 import numpy as np
 
 from attitude_fmu.blocks.stages.timing import same_step
-from attitude_fmu.fmu_src.fmu_support import IN, OUT, PAR, Integer, ProjectSlave
-from attitude_fmu.systems.simulation.motion import EARTH_FIELD_UT
-from attitude_fmu.systems.simulation.sensor_model import ImuModel, mag_noise_generator
+from attitude_fmu.fmu_src.fmu_support import ProjectSlave
+from attitude_fmu.fmu_src.simulation_variables import imu_sensor
+from attitude_fmu.systems.simulation.noise import MAGNETOMETER, SENSOR, NoiseStream
+from attitude_fmu.systems.simulation.sensor_model import ImuModel
 
 
 class ImuSensor(ProjectSlave):
@@ -27,23 +28,7 @@ class ImuSensor(ProjectSlave):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        self.vector("omega", (0.0, 0.0, 0.0), "rad/s", "true angular rate {c}, mean over the step", IN)
-        self.vector("f", (0.0, 0.0, 9.81), "m/s2", "true specific force {c}", IN)
-        self.vector("m", EARTH_FIELD_UT, "uT", "true magnetic field {c}", IN)
-        self.vector("gyr", (0.0, 0.0, 0.0), "rad/s", "measured angular rate {c}", OUT)
-        self.vector("acc", (0.0, 0.0, 9.81), "m/s2", "measured specific force {c}", OUT)
-        self.vector("mag", EARTH_FIELD_UT, "uT", "measured magnetic field {c}", OUT)
-        self.real("delta_n", 0.0, "rad/s/sqrt(Hz)", "gyro white-noise density, one-sided", PAR)
-        self.vector("gyr_offset", (0.0, 0.0, 0.0), "rad/s", "constant gyro offset {c}", PAR)
-        for row in "xyz":
-            self.vector(f"gyr_scale_{row}", (0.0, 0.0, 0.0), "1",
-                        f"gyro scale and misalignment error: share of the true rate's {{c}} in gyr_{row}", PAR)
-        self.real("acc_noise", 0.0, "m/s2/sqrt(Hz)", "accelerometer white-noise density, one-sided", PAR)
-        self.vector("acc_offset", (0.0, 0.0, 0.0), "m/s2", "constant accelerometer offset {c}", PAR)
-        self.real("latency", 0.0, "s", "how long gyr and acc lag the motion (a fixed step needed)", PAR)
-        self.real("mag_noise", 0.0, "uT/sqrt(Hz)", "magnetometer white-noise density, one-sided", PAR)
-        self.vector("mag_offset", (0.0, 0.0, 0.0), "uT", "hard iron: a field {c} fixed to the sensor", PAR)
-        self.parameter("seed", 1, "seed of the noise generator", Integer)
+        self.register_table(imu_sensor())
         self.model = None
 
     def initialise(self):
@@ -56,7 +41,7 @@ class ImuSensor(ProjectSlave):
                 latency=self.latency, mag_noise=self.mag_noise,
                 mag_offset=(self.mag_offset_x, self.mag_offset_y, self.mag_offset_z),
             )
-            self.rng, self.mag_rng = np.random.default_rng(self.seed), mag_noise_generator(self.seed)
+            self.rng, self.mag_rng = NoiseStream(self.seed, SENSOR), NoiseStream(self.seed, MAGNETOMETER)
             self.delay, self.step_size = None, None
         except ValueError as exc:
             self.fail(f"invalid parameter: {exc}")
@@ -73,9 +58,9 @@ class ImuSensor(ProjectSlave):
             elif not same_step(step_size, self.step_size):
                 return self.fail(f"latency needs a fixed step: got {step_size!r} s after {self.step_size!r} s")
             self.delay, signals = self.model.delay_step(self.delay, signals, 1.0 / self.step_size)
-        gyr, acc = self.model.measure(signals[0:3], signals[3:6], self.rng.standard_normal(6), 1.0 / step_size)
+        gyr, acc = self.model.measure(signals[0:3], signals[3:6], self.rng.next(), 1.0 / step_size)
         self.gyr_x, self.gyr_y, self.gyr_z = (float(v) for v in gyr)
         self.acc_x, self.acc_y, self.acc_z = (float(v) for v in acc)
-        mag = self.model.measure_mag((self.m_x, self.m_y, self.m_z), self.mag_rng.standard_normal(3), 1.0 / step_size)
+        mag = self.model.measure_mag((self.m_x, self.m_y, self.m_z), self.mag_rng.next(), 1.0 / step_size)
         self.mag_x, self.mag_y, self.mag_z = (float(v) for v in mag)
         return True

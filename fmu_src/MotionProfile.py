@@ -8,8 +8,9 @@ from __future__ import annotations
 
 from scipy.spatial.transform import Rotation
 
-from attitude_fmu.fmu_src.fmu_support import OUT, PAR, Integer, ProjectSlave, fmi_unit
-from attitude_fmu.systems.simulation.motion import EARTH_FIELD_UT, PROFILES, profile
+from attitude_fmu.fmu_src.fmu_support import ProjectSlave
+from attitude_fmu.fmu_src.simulation_variables import motion_profile
+from attitude_fmu.systems.simulation.motion import EARTH_FIELD_UT, profile
 
 
 class MotionProfile(ProjectSlave):
@@ -19,17 +20,7 @@ class MotionProfile(ProjectSlave):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        self.vector("omega", (0.0, 0.0, 0.0), "rad/s", "true angular rate {c}, mean over the step", OUT)
-        self.vector("f", (0.0, 0.0, 9.81), "m/s2", "true specific force {c}, sensor coordinates", OUT)
-        self.vector("m", EARTH_FIELD_UT, "uT", "true magnetic field {c}, sensor coordinates", OUT)
-        self.vector("qt", (1.0, 0.0, 0.0, 0.0), "1", "true orientation quaternion {c}, sensor -> earth (ENU)", OUT,
-                    "wxyz")
-        self.parameter("profile", "human", f"motion profile: {', '.join(PROFILES)}")
-        self.parameter("seed", 0, "seed of random profiles", Integer)
-        self.real("g", 9.81, "m/s2", "magnitude of gravity", PAR)
-        for prof in PROFILES.values():
-            for p in prof.params:
-                self.real(f"{prof.name}_{p.name}", p.default, fmi_unit(p.unit), f"{prof.name}: {p.doc}", PAR)
+        self.register_table(motion_profile())
         self.stream = None
 
     def initialise(self):

@@ -1,6 +1,6 @@
-"""FMI plumbing shared by the project's pythonfmu FMUs: units on Real variables, the
-UnitDefinitions they refer to, compact registration of variables, and the check that the
-attitude_fmu code a process runs is the FMU's own.
+"""FMI plumbing shared by the project's pythonfmu FMUs: registration of their variables from
+a table (fmu_src.variables) whose model description they write, FMU states, and the check
+that the attitude_fmu code a process runs is the FMU's own.
 
 The models' equations live in `blocks/` and `systems/`; an FMU here only maps FMI
 variables onto them.
@@ -10,37 +10,17 @@ from __future__ import annotations
 import copy
 import hashlib
 import importlib.util
-import math
 import pickle
 import sys
 from pathlib import Path
-from xml.etree.ElementTree import Element, SubElement
+from xml.etree.ElementTree import Element
 
 from pythonfmu import Boolean, Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Integer, Real, String
 from pythonfmu.enums import Fmi2Status
 
-# FMI unit name → SI base-unit exponents (FMI 2.0 BaseUnit attributes); None for the
-# noise densities per √Hz, whose half-integer exponents FMI 2.0 cannot state
-UNITS = {
-    "s": {"s": 1},
-    "Hz": {"s": -1},
-    "m": {"m": 1},
-    "rad": {"rad": 1},
-    "deg": {"rad": 1, "factor": 0.017453292519943295},
-    "rad/s": {"rad": 1, "s": -1},
-    "1/s": {"s": -1},
-    "1/s2": {"s": -2},
-    "rad/s/sqrt(Hz)": None,
-    "m/s/sqrt(Hz)": None,
-    "m/s2/sqrt(Hz)": None,
-    "m/s2": {"m": 1, "s": -2},
-    "uT": {"kg": 1, "s": -2, "A": -1, "factor": 1e-6},
-    "uT/sqrt(Hz)": None,
-    "1": {},
-}
+from attitude_fmu.fmu_src.model_description import model_structure, model_variables, unit_definitions
+from attitude_fmu.fmu_src.variables import BOOLEAN, INTEGER, REAL, STRING, Table
 
-
-IN, OUT, PAR = Fmi2Causality.input, Fmi2Causality.output, Fmi2Causality.parameter
 PACKAGE = "attitude_fmu"  # the modules of it an FMU imports are in its resources, under this name
 INTERNAL_STATE = " internal"  # key of a saved FMU state's model part (no variable name has a space)
 _file_digests: dict[Path, str] = {}  # source file → SHA-256 of its contents, taken the first time it is read
@@ -105,32 +85,6 @@ def foreign_code(resources) -> str | None:
     return None
 
 
-def fmi_unit(unit: str) -> str:
-    """The FMI unit name of a unit as the project documents it ("m/s²" → "m/s2", "√Hz" → "sqrt(Hz)")."""
-    name = unit.replace("√Hz", "sqrt(Hz)").replace("²", "2")
-    if name not in UNITS:
-        raise ValueError(f"unit {unit!r} has no FMI definition in fmu_support.UNITS")
-    return name
-
-
-class UnitReal(Real):
-    """A pythonfmu Real with an FMI unit attribute."""
-
-    def __init__(self, name: str, unit: str, **kwargs):
-        if unit not in UNITS:
-            raise ValueError(f"unit {unit!r} has no definition in fmu_support.UNITS")
-        super().__init__(name, **kwargs)
-        self.unit = unit
-
-    def to_xml(self) -> Element:
-        node = super().to_xml()
-        real = node.find("Real")
-        real.set("unit", self.unit)
-        if self.start is not None:  # exactly (pythonfmu writes 16 digits), and NaN as XML Schema spells it
-            real.set("start", "NaN" if math.isnan(self.start) else repr(float(self.start)))
-        return node
-
-
 class ProjectSlave(Fmi2Slave):
     """Fmi2Slave with units and helpers; subclasses register their variables and build
     their model from the parameters in initialise().
@@ -145,6 +99,7 @@ class ProjectSlave(Fmi2Slave):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
+        self.table = Table()  # the variables registered, by value reference
         self.error = foreign_code(self.resources)
 
     def _get_fmu_state(self) -> dict:
@@ -183,40 +138,30 @@ class ProjectSlave(Fmi2Slave):
         """Build the model from the parameters; an invalid one: fail(message)."""
 
     def to_xml(self, model_options=None) -> Element:
+        """pythonfmu's model description with the variables' sections written from the table."""
         root = super().to_xml(model_options or {})
-        used = sorted({v.unit for v in self.vars.values() if isinstance(v, UnitReal)})
-        definitions = Element("UnitDefinitions")
-        for name in used:
-            unit = SubElement(definitions, "Unit", name=name)
-            if UNITS[name] is not None:
-                SubElement(unit, "BaseUnit", {k: str(v) for k, v in UNITS[name].items()})
-        root.insert(list(root).index(root.find("CoSimulation")) + 1, definitions)
+        for name in ("ModelVariables", "ModelStructure"):
+            root.remove(root.find(name))
+        root.insert(list(root).index(root.find("CoSimulation")) + 1, unit_definitions(self.table))
+        root.append(model_variables(self.table))
+        root.append(model_structure(self.table))
         return root
 
-    def real(self, name, start, unit, description, causality):
-        """Register a Real input, output or (fixed) parameter held in attribute `name`."""
-        setattr(self, name, float(start))
-        variability = Fmi2Variability.fixed if causality == Fmi2Causality.parameter else Fmi2Variability.continuous
-        # outputs start exact: pythonfmu writes no InitialUnknowns for calculated ones
-        extra = {"initial": Fmi2Initial.exact} if causality == Fmi2Causality.output else {}
-        self.register_variable(UnitReal(name, unit, causality=causality, variability=variability,
-                                        description=description, **extra), nested=False)
+    def register(self, rows) -> None:
+        """Register rows of self.table (fmu_src.variables.Variable) with pythonfmu, each
+        held in the attribute of its name, which starts at its start value."""
+        for v in rows:
+            setattr(self, v.name, v.start)
+            extra = {"initial": Fmi2Initial[v.initial]} if v.initial else {}
+            self.register_variable(_PYTHONFMU_TYPES[v.type](
+                v.name, causality=Fmi2Causality[v.causality], variability=Fmi2Variability[v.variability],
+                description=v.description, **extra), nested=False)
+            if self.vars[v.value_reference].name != v.name:
+                raise ValueError(f"{v.name}: pythonfmu numbers it otherwise than the table")
 
-    def vector(self, prefix, start, unit, description, causality, components="xyz"):
-        """Register prefix_<c> for each component c; description may use {c}."""
-        for c, value in zip(components, start):
-            self.real(f"{prefix}_{c}", value, unit, description.format(c=c), causality)
-
-    def parameter(self, name, start, description, kind=String):
-        """Register a fixed String, Integer or Boolean parameter held in attribute `name`."""
-        setattr(self, name, start)
-        self.register_variable(kind(name, causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,
-                                    description=description), nested=False)
-
-    def boolean_output(self, name, start, description):
-        setattr(self, name, start)
-        self.register_variable(Boolean(name, causality=Fmi2Causality.output, variability=Fmi2Variability.discrete,
-                                       initial=Fmi2Initial.exact, description=description), nested=False)
+    def register_table(self, rows) -> None:
+        """Register every row of another table (an interface of fmu_src.variables)."""
+        self.register(self.table.extend_from(rows))
 
     error = None  # the message of an invalid configuration or of foreign code, once one was found
 
@@ -237,4 +182,6 @@ class ProjectSlave(Fmi2Slave):
         return False
 
 
-__all__ = ["ProjectSlave", "Fmi2Status", "Integer", "String", "UNITS", "IN", "OUT", "PAR", "fmi_unit"]
+_PYTHONFMU_TYPES = {REAL: Real, INTEGER: Integer, BOOLEAN: Boolean, STRING: String}
+
+__all__ = ["ProjectSlave", "Fmi2Status"]

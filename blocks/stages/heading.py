@@ -204,7 +204,9 @@ def heading_step(state, coef, q, m_sensor):
     if online:
         mag_delay.turn(state[MAG_DELAY], delay_coef, turn)
     n2 = m_sensor[0] * m_sensor[0] + m_sensor[1] * m_sensor[1] + m_sensor[2] * m_sensor[2]
-    if math.isfinite(n2) and n2 > 0.0:  # a field sample (not NaN: missing, not all 0: none)
+    # a field sample (not NaN: missing, not all 0: none, not infinite); math.isfinite is true of inf in a
+    # kernel compiled with fast-math, math.isinf is not
+    if n2 > 0.0 and not math.isinf(n2):
         m_sensor, proven = hard_iron_step(state[HARD_IRON], coef[HARD_IRON_COEF], m_sensor, state[GAP], coef[2],
                                           coef[5])
         if proven:  # a field freed of (or back without) an offset: start afresh from it

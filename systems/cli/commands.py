@@ -1,4 +1,4 @@
-"""The `attitude` command line: estimate, evaluate, plot, table1, verify, compare, bode, bench."""
+"""The `attitude` command line: estimate, evaluate, plot, table1, verify, ssp, compare, bode, bench."""
 from __future__ import annotations
 
 import argparse
@@ -136,6 +136,14 @@ def _read_options(args) -> dict:
             "gyr_axes": args.gyr_axes, "acc_axes": args.acc_axes, "mag_axes": args.mag_axes}
 
 
+def _add_verify_flags(parser) -> None:
+    parser.add_argument("--fmu-dir", default="dist", help="where the FMUs are, built there if missing or built from "
+                        "other sources (default dist/)")
+    parser.add_argument("--rebuild", action="store_true", help="build the FMUs even if present")
+    parser.add_argument("--profile", action="append", help="only this profile (repeatable)")
+    parser.add_argument("--method", action="append", help="only this method (repeatable)")
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="attitude", description="IMU attitude estimators (Rizun's optimal Wiener filter and peers).",
@@ -198,10 +206,16 @@ def build_parser() -> argparse.ArgumentParser:
 
     vf = sub.add_parser("verify", help="co-simulate every profile with every estimator as FMUs; exit 1 if a bound is missed")
     vf.add_argument("--json", action="store_true")
-    vf.add_argument("--fmu-dir", default="dist", help="where the FMUs are, built there if missing or built from other sources (default dist/)")
-    vf.add_argument("--rebuild", action="store_true", help="build the FMUs even if present")
-    vf.add_argument("--profile", action="append", help="only this profile (repeatable)")
-    vf.add_argument("--method", action="append", help="only this method (repeatable)")
+    _add_verify_flags(vf)
+    vf.add_argument("--python", action="store_true", help="also run the pythonfmu chain and hold its estimator "
+                    "outputs to the native chain's within 1e-9 (minutes instead of seconds)")
+    ss = sub.add_parser("ssp", help="write verify's SSP of each profile × method, the FMUs inside, for other tools")
+    ss.add_argument("--out", type=Path, required=True, help="folder for the files <profile>_<method>.ssp")
+    _add_verify_flags(ss)
+    chain = ss.add_mutually_exclusive_group()
+    chain.add_argument("--native", dest="chain", action="store_const", const="native", default="native",
+                       help="the FMUs in C (DIR/native; default)")
+    chain.add_argument("--python", dest="chain", action="store_const", const="python", help="the pythonfmu FMUs")
 
     cp = sub.add_parser("compare", help="every estimator and the peers vqf, madgwick on every motion profile")
     cp.add_argument("--profile", action="append", help="only this profile (repeatable)")
@@ -224,7 +238,8 @@ def build_parser() -> argparse.ArgumentParser:
     bn.add_argument("--json", action="store_true")
     bn.add_argument("--samples", type=int, default=100_000)
     bn.add_argument("--fmu", action="store_true",
-                    help="per-step cost of AttitudeEstimator.fmu against a no-op FMU of the same interface")
+                    help="per-step cost of AttitudeEstimator.fmu against a no-op FMU of the same interface, pythonfmu "
+                         "and native, under fmpy; and of the native against the pythonfmu one in a C host")
     bn.add_argument("--repeat", type=int, default=10, help="interleaved rounds; each method's best run counts (default 10)")
     return parser
 
@@ -425,28 +440,48 @@ def cmd_table1(args) -> int:
     return 0
 
 
-def cmd_verify(args) -> int:
+def _verified_fmus(args) -> Path:
+    """The FMU folder, built where needed, once the profiles and methods asked for are known."""
     from attitude_fmu.systems.fmi.build import ensure_built
-    from attitude_fmu.systems.fmi.verify import SCENARIOS, verify
-    from attitude_fmu.systems.simulation.motion import PROFILES
+    from attitude_fmu.systems.fmi.verify import SCENARIOS
 
     for name in args.profile or []:
         if name not in SCENARIOS:
             raise ValueError(f"unknown profile {name!r}; verified profiles: {', '.join(SCENARIOS)}")
     for name in args.method or []:
         known_method(name)  # refuses unknown names
-    fmu_dir = ensure_built(args.fmu_dir, args.rebuild, log=lambda m: print(f"attitude: {m}", file=sys.stderr))
-    rows = verify(fmu_dir, args.profile, args.method)
+    return ensure_built(args.fmu_dir, args.rebuild, log=lambda m: print(f"attitude: {m}", file=sys.stderr))
+
+
+def cmd_ssp(args) -> int:
+    from attitude_fmu.systems.fmi.verify import write_verify_ssps
+
+    for path in write_verify_ssps(_verified_fmus(args), args.out, args.profile, args.method, args.chain):
+        print(path)
+    return 0
+
+
+def cmd_verify(args) -> int:
+    from attitude_fmu.systems.fmi.verify import verify
+    from attitude_fmu.systems.simulation.motion import PROFILES
+
+    rows = verify(_verified_fmus(args), args.profile, args.method, python=args.python)
     if args.json:
         print(json.dumps({"rows": rows}, indent=2))
     else:
-        print(f"{'profile':>15} {'method':>14} {'rms °':>8} {'max °':>8} {'mean °':>9}  {'bound °':>8} {'on':>4}  result")
+        print(f"{'profile':>15} {'method':>14} {'rms °':>8} {'max °':>8} {'mean °':>9}  {'bound °':>8} {'on':>4}  result"
+              f"  {'native Δ':>9}")
         for r in rows:
             bound = "       —" if r["bound_deg"] is None else f"{r['bound_deg']:8.3g}"
             result = "report" if r["bound_deg"] is None else "pass" if r["pass"] else "FAIL"
+            native = "        —" if r["native_max_diff"] is None else \
+                f"{r['native_max_diff']:9.2g}" + ("" if r["native_valid_equal"] else " (valid differs)")
             print(f"{r['profile']:>15} {r['method']:>14} {r['rms_deg']:8.3g} {r['max_deg']:8.3g} {r['mean_deg']:9.3g}"
-                  f"  {bound} {r['metric']:>4}  {result}")
+                  f"  {bound} {r['metric']:>4}  {result:<6}  {native}")
         print("profiles: " + "; ".join(f"{n}: {PROFILES[n].summary}" for n in dict.fromkeys(r["profile"] for r in rows)))
+        print(f"chain: {rows[0]['chain'] if rows else '—'}; native Δ: the largest difference between the estimator "
+              "outputs (Euler angles aside) of the native chain (FMUs in C) and the pythonfmu one, with the same "
+              "seeds (— without --python)")
     failed = [r for r in rows if not r["pass"]]
     if failed:
         print(f"attitude: {len(failed)} of {len(rows)} rows missed their bound", file=sys.stderr)
@@ -498,8 +533,13 @@ def cmd_bench(args) -> int:
         else:
             print(f"{result['steps']} steps under fmpy, best of {args.repeat} interleaved rounds")
             for name, us in result["us_per_step"].items():
-                print(f"{name:>18} {us:8.1f} µs/step")
-            print(f"{'ratio':>18} {result['ratio_vs_noop']:8.2f}")
+                print(f"{name:>24} {us:8.2f} µs/step")
+            print(f"{'ratio':>24} {result['ratio_vs_noop']:8.2f}  (pythonfmu: estimator / no-op)")
+            print(f"{'native ratio':>24} {result['native_ratio_vs_noop']:8.2f}  (in C: estimator / no-op; target ≤ 1.2)")
+            print(f"in a C host with no Python, best of {args.repeat} rounds")
+            for name, us in result["c_host_us_per_step"].items():
+                print(f"{name:>24} {us:8.3f} µs/step")
+            print(f"{'native speed-up':>24} {result['native_speedup_c_host']:8.1f}  (pythonfmu / native; target ≥ 20)")
         return 0
     result = bench(n=args.samples, repeat=args.repeat)
     if args.json:
@@ -514,7 +554,7 @@ def cmd_bench(args) -> int:
 
 def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
-    handler = {"estimate": cmd_estimate, "evaluate": cmd_evaluate, "plot": cmd_plot, "table1": cmd_table1, "verify": cmd_verify, "compare": cmd_compare,
+    handler = {"estimate": cmd_estimate, "evaluate": cmd_evaluate, "plot": cmd_plot, "table1": cmd_table1, "verify": cmd_verify, "ssp": cmd_ssp, "compare": cmd_compare,
                "bode": cmd_bode, "bench": cmd_bench}[args.command]
     try:
         if hasattr(args, "latency"):

@@ -1,9 +1,13 @@
 """Throughput of the batch estimator against vqf's C++ core and ahrs' Madgwick, same run."""
 from __future__ import annotations
 
+import subprocess
 import sys
+import tempfile
 import time
+from pathlib import Path
 
+import fmpy
 import numpy as np
 
 from attitude_fmu.blocks.pipeline.batch import estimate
@@ -76,50 +80,100 @@ def bench(n: int = 100_000, repeat: int = 5, budget_s: float = 3.0, progress: bo
     }
 
 
-def bench_fmu(steps: int = 5000, repeat: int = 5, progress: bool = True) -> dict:
-    """Per-step cost (µs) of AttitudeEstimator.fmu and of a no-op FMU with its interface,
-    both driven by fmpy (set inputs, doStep, get outputs) in interleaved rounds."""
-    import tempfile
+def _fmpy_rounds(fmus: dict, inputs, steps: int, repeat: int, progress: bool) -> dict:
+    """Best µs per step of each extracted FMU (name → (md, folder)) in fmpy's FMU2Slave loop
+    (set inputs, doStep, get outputs), over interleaved rounds."""
+    from attitude_fmu.systems.fmi.cosim import load_slave
 
+    loaded = {}
+    for name, (md, folder) in fmus.items():
+        vr = {v.name: v.valueReference for v in md.modelVariables}
+        fmu = load_slave(md, folder, name.replace("/", "_"))
+        fmu.instantiate()  # once: pythonfmu cannot instantiate again after fmi2FreeInstance
+        loaded[name] = (fmu, [vr[n] for n in FMU_INPUTS], [vr[n] for n in FMU_OUTPUTS], [vr["valid"]])
+    best = dict.fromkeys(loaded, np.inf)
+    for round_ in range(repeat):
+        for name, (fmu, vin, vout, vvalid) in loaded.items():
+            if progress:
+                print(f"bench: round {round_ + 1}/{repeat}, {name} under fmpy, {steps} steps", file=sys.stderr, flush=True)
+            fmu.reset()
+            fmu.setupExperiment(startTime=0.0)
+            fmu.enterInitializationMode()
+            fmu.exitInitializationMode()
+            start = time.perf_counter()
+            for k in range(steps):
+                fmu.setReal(vin, inputs[k].tolist())
+                fmu.doStep(currentCommunicationPoint=k / BENCH_FS, communicationStepSize=1.0 / BENCH_FS)
+                fmu.getReal(vout)
+                fmu.getBoolean(vvalid)
+            best[name] = min(best[name], (time.perf_counter() - start) / steps)
+            fmu.terminate()
+    for fmu, *_ in loaded.values():
+        fmu.freeInstance()
+    return {name: t * 1e6 for name, t in best.items()}
+
+
+def _c_host_rounds(fmus: dict, inputs, repeat: int, tmp: Path, progress: bool) -> dict:
+    """Best µs per step of each extracted FMU (name → (md, folder)) in a C host with no
+    Python in its process (systems/evaluation/fmi_bench.c), each in a process of its own."""
+    from attitude_fmu.systems.fmi.native import FMI_HEADERS, compiler
+
+    host, data = tmp / "fmi_bench", tmp / "inputs.bin"
+    subprocess.run([*compiler(), "-std=c99", "-O2", f"-I{FMI_HEADERS}", "-o", str(host),
+                    str(Path(__file__).with_name("fmi_bench.c")), "-ldl"], check=True, capture_output=True, text=True)
+    np.ascontiguousarray(inputs, dtype=float).tofile(data)
+    result = {}
+    for name, (md, folder) in fmus.items():
+        if progress:
+            print(f"bench: {name} in a C host, best of {repeat} rounds of {len(inputs)} steps", file=sys.stderr,
+                  flush=True)
+        vr = {v.name: v.valueReference for v in md.modelVariables}
+        identifier = md.coSimulation.modelIdentifier
+        binary = Path(folder) / "binaries" / fmpy.platform / f"{identifier}{fmpy.sharedLibraryExtension}"
+        proc = subprocess.run([str(host), str(binary), md.guid, (Path(folder) / "resources").as_uri(), str(data),
+                               repr(1.0 / BENCH_FS), str(repeat), ",".join(str(vr[n]) for n in FMU_INPUTS),
+                               ",".join(str(vr[n]) for n in FMU_OUTPUTS), str(vr["valid"])],
+                              capture_output=True, text=True)
+        if proc.returncode != 0:
+            raise RuntimeError(f"the C host failed on {name} ({proc.returncode}): {proc.stderr[-2000:]}")
+        result[name] = float(proc.stdout.split()[-1]) / 1e3
+    return result
+
+
+FMU_INPUTS = [f"{s}_{a}" for s in ("gyr", "acc") for a in "xyz"]
+FMU_OUTPUTS = ["q_w", "q_x", "q_y", "q_z", "g_x", "g_y", "g_z", "roll", "pitch", "yaw"]
+
+
+def bench_fmu(steps: int = 5000, repeat: int = 5, progress: bool = True) -> dict:
+    """Per-step cost (µs) of the estimator FMUs against no-op FMUs of their interface.
+
+    Under fmpy (set inputs, doStep, get outputs, in interleaved rounds): the pythonfmu
+    AttitudeEstimator.fmu and NoOpEstimator.fmu, and the native ones (native/…; in C).
+    In a C host with no Python in its process: the native AttitudeEstimator.fmu against the
+    pythonfmu one (c_host; native_speedup = pythonfmu's cost / native's). All in one run."""
     from fmpy import extract, read_model_description
 
     from attitude_fmu.systems.fmi.build import build_fmus
-    from attitude_fmu.systems.fmi.cosim import load_slave
 
     gyr, acc = bench_recording(steps)
     inputs = np.hstack([gyr, acc])
+    names = ("AttitudeEstimator", "NoOpEstimator")
     with tempfile.TemporaryDirectory(prefix="attitude_bench_") as tmp:
         if progress:
-            print("bench: building AttitudeEstimator.fmu and NoOpEstimator.fmu", file=sys.stderr, flush=True)
-        paths = build_fmus(tmp, ("AttitudeEstimator", "NoOpEstimator"))
+            print("bench: building AttitudeEstimator.fmu and NoOpEstimator.fmu, pythonfmu and native",
+                  file=sys.stderr, flush=True)
+        paths = build_fmus(tmp, names, names)
         fmus = {}
         for path in paths:
-            md = read_model_description(path)
-            vr = {v.name: v.valueReference for v in md.modelVariables}
-            fmu = load_slave(md, extract(path), path.stem)
-            fmu.instantiate()  # once: pythonfmu cannot instantiate again after fmi2FreeInstance
-            fmus[path.stem] = (fmu, [vr[f"{s}_{a}"] for s in ("gyr", "acc") for a in "xyz"],
-                               [vr[n] for n in ("q_w", "q_x", "q_y", "q_z", "g_x", "g_y", "g_z", "roll", "pitch", "yaw")],
-                               [vr["valid"]])
-        best = dict.fromkeys(fmus, np.inf)
-        for round_ in range(repeat):
-            for name, (fmu, vin, vout, vvalid) in fmus.items():
-                if progress:
-                    print(f"bench: round {round_ + 1}/{repeat}, {name}, {steps} steps", file=sys.stderr, flush=True)
-                fmu.reset()
-                fmu.setupExperiment(startTime=0.0)
-                fmu.enterInitializationMode()
-                fmu.exitInitializationMode()
-                start = time.perf_counter()
-                for k in range(steps):
-                    fmu.setReal(vin, inputs[k].tolist())
-                    fmu.doStep(currentCommunicationPoint=k / BENCH_FS, communicationStepSize=1.0 / BENCH_FS)
-                    fmu.getReal(vout)
-                    fmu.getBoolean(vvalid)
-                best[name] = min(best[name], (time.perf_counter() - start) / steps)
-                fmu.terminate()
-        for fmu, *_ in fmus.values():
-            fmu.freeInstance()
-    per_step = {name: t * 1e6 for name, t in best.items()}
+            name = path.stem if path.parent == Path(tmp) else f"native/{path.stem}"
+            fmus[name] = (read_model_description(path), extract(path))
+        if set(fmus) != {*names, *(f"native/{n}" for n in names)}:
+            raise RuntimeError("attitude bench --fmu needs the native FMUs: a C compiler (see the warning above)")
+        per_step = _fmpy_rounds(fmus, inputs, steps, repeat, progress)
+        c_host = _c_host_rounds({n: fmus[n] for n in ("native/AttitudeEstimator", "AttitudeEstimator")}, inputs,
+                                repeat, Path(tmp), progress)
     return {"steps": steps, "us_per_step": per_step,
-            "ratio_vs_noop": per_step["AttitudeEstimator"] / per_step["NoOpEstimator"]}
+            "ratio_vs_noop": per_step["AttitudeEstimator"] / per_step["NoOpEstimator"],
+            "native_ratio_vs_noop": per_step["native/AttitudeEstimator"] / per_step["native/NoOpEstimator"],
+            "c_host_us_per_step": c_host,
+            "native_speedup_c_host": c_host["AttitudeEstimator"] / c_host["native/AttitudeEstimator"]}

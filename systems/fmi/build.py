@@ -1,4 +1,6 @@
-"""Building the project's FMUs (FMI 2.0 co-simulation) from fmu_src/ with pythonfmu.
+"""Building the project's FMUs (FMI 2.0 co-simulation): those of fmu_src/ with pythonfmu
+into DIR/, and the native ones, in C with no Python (systems.fmi.native), into DIR/native/, the
+native estimator also as FMI 3.0 co-simulation (systems.fmi.fmi3) into DIR/native/fmi3/.
 
 Each FMU carries in its resources the modules of attitude_fmu that its fmu_src adapter
 imports (carried_files), so it runs where only numpy, scipy, control and pythonfmu are
@@ -16,7 +18,6 @@ from __future__ import annotations
 import ast
 import hashlib
 import json
-import os
 import shlex
 import shutil
 import site
@@ -29,6 +30,8 @@ from pathlib import Path
 
 import attitude_fmu
 from attitude_fmu.fmu_src.fmu_support import PACKAGE, code_digest
+from attitude_fmu.systems.fmi import fmi3
+from attitude_fmu.systems.fmi.native import NATIVE_NAMES, build_native_fmus, compiler, is_current
 
 FMU_NAMES = ("AttitudeEstimator", "ImuSensor", "MotionProfile")
 PACKAGE_DIR = Path(attitude_fmu.__file__).resolve().parent
@@ -117,8 +120,10 @@ def built_from(fmu) -> str | None:
         return None
 
 
-def build_fmus(out, names=FMU_NAMES) -> list[Path]:
-    """Build the named FMUs into the directory out; returns their paths."""
+def build_fmus(out, names=FMU_NAMES, native=NATIVE_NAMES, fmi3_names=fmi3.FMI3_NAMES) -> list[Path]:
+    """Build the named pythonfmu FMUs into the directory out, the named native ones into
+    out/native and the named FMI 3.0 ones into out/native/fmi3 (none without a C compiler: a
+    warning says so); returns their paths."""
     from pythonfmu.builder import FmuBuilder
 
     out = Path(out)
@@ -142,7 +147,7 @@ def build_fmus(out, names=FMU_NAMES) -> list[Path]:
             with zipfile.ZipFile(path, "a", zipfile.ZIP_DEFLATED) as zf:
                 zf.writestr(FINGERPRINT, source_fingerprint(path.stem) + "\n")
                 zf.writestr(PYTHON_ENVIRONMENT, python_environment())
-    return built
+    return built + build_native_fmus(out / "native", native) + fmi3.build_fmi3_fmus(out / "native" / "fmi3", fmi3_names)
 
 
 GUARD_PLATFORMS = {"linux": "linux64", "darwin": "darwin64"}  # sys.platform prefix → FMI binaries folder
@@ -157,8 +162,7 @@ def guard_platform() -> str | None:
 def compile_guard(out: Path, log=lambda m: print(m, file=sys.stderr)) -> Path | None:
     """Compile fmi2_guard.c into the shared library out; None (with a warning) where it cannot be."""
     platform = guard_platform()
-    cc = shlex.split(os.environ.get("CC") or sysconfig.get_config_var("CC") or "cc")
-    command = [*cc, "-shared", "-fPIC", "-O2", "-fvisibility=hidden", "-o", str(out),
+    command = [*compiler(), "-shared", "-fPIC", "-O2", "-fvisibility=hidden", "-o", str(out),
                str(SOURCE_DIR / "fmi2_guard.c"), "-ldl", "-lpthread"]
     consequence = ("the FMUs keep pythonfmu's own binary: an invalid parameter ends in fmi2Discard "
                    "instead of fmi2Error, and log messages need debug logging on")
@@ -195,14 +199,22 @@ def install_guard(fmu: Path, guard: Path) -> None:
 def ensure_built(fmu_dir, rebuild: bool = False, log=print) -> Path:
     """The directory holding every FMU, building those missing or built from other sources
     than this installation's (or all with rebuild): FMUs loaded into one process share the
-    first-loaded copy of the project's modules, so the ones run must match the code."""
+    first-loaded copy of the project's modules, so the ones run must match the code; a
+    native FMU's guid is a digest of its sources (systems.fmi.native.is_current)."""
     fmu_dir = Path(fmu_dir)
-    missing = [n for n in FMU_NAMES if rebuild or not (fmu_dir / f"{n}.fmu").is_file()]
-    stale = [n for n in FMU_NAMES if n not in missing and built_from(fmu_dir / f"{n}.fmu") != source_fingerprint(n)]
+    names = {n: fmu_dir / f"{n}.fmu" for n in FMU_NAMES}
+    names.update({f"native/{n}": fmu_dir / "native" / f"{n}.fmu" for n in NATIVE_NAMES})
+    names.update({f"native/fmi3/{n}": fmu_dir / "native" / "fmi3" / f"{n}.fmu" for n in fmi3.FMI3_NAMES})
+    missing = [n for n, path in names.items() if rebuild or not path.is_file()]
+    stale = [n for n, path in names.items() if n not in missing and not (
+        fmi3.is_current(path) if n.startswith("native/fmi3/") else is_current(path) if n.startswith("native/")
+        else built_from(path) == source_fingerprint(n))]
     if missing:
         log(f"building {', '.join(missing)} into {fmu_dir}")
     if stale:
         log(f"rebuilding {', '.join(stale)} in {fmu_dir}: built from other sources than these")
-    if missing or stale:
-        build_fmus(fmu_dir, [n for n in FMU_NAMES if n in missing or n in stale])
+    todo = set(missing) | set(stale)
+    if todo:
+        build_fmus(fmu_dir, [n for n in FMU_NAMES if n in todo], [n for n in NATIVE_NAMES if f"native/{n}" in todo],
+                   [n for n in fmi3.FMI3_NAMES if f"native/fmi3/{n}" in todo])
     return fmu_dir

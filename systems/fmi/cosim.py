@@ -7,7 +7,8 @@ connections only after every component has stepped, so each connection delays by
 step and every connector starts at 0. This master reads the same SSD with fmpy, applies
 its inline parameter values of every type, and steps the components in the order of
 their connections (Gauss–Seidel): in doStep(t, h) the estimator receives the sensor
-samples of (t, t+h], exactly as the batch path consumes them. cosimulate_libcosim runs
+samples of (t, t+h], exactly as the batch path consumes them. The steps run in C
+(systems.fmi.stepping) where a C compiler is at hand, else in Python. cosimulate_libcosim runs
 the same SSP in a second importer, independent of fmpy (libcosim).
 """
 from __future__ import annotations
@@ -21,6 +22,8 @@ from fmpy import extract, read_model_description
 from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import FMU2Slave
 from fmpy.ssp.ssd import read_ssd
+
+from attitude_fmu.systems.fmi import stepping
 
 _loaded = False  # whether this process has loaded an FMU's library
 
@@ -102,26 +105,11 @@ def cosimulate(ssp_path, stop_time: float, step_size: float, progress=None) -> d
             except FMICallException as exc:
                 raise RuntimeError(f"component {element.name} failed to initialise: {exc}") from None
         n = int(round(stop_time / step_size))
-        record = {f"{c.name}.{v}": np.empty(n, dtype=bool if v in c.bool_out else float)
-                  for c in components.values() for v in c.outputs}
-        latest = {c.name: {} for c in components.values()}
-        for k in range(n):
-            t = k * step_size
-            for comp in order:
-                if comp.inputs:
-                    comp.fmu.setReal(comp.input_vr, [latest[src][out] for _, src, out in comp.inputs])
-                try:
-                    comp.fmu.doStep(currentCommunicationPoint=t, communicationStepSize=step_size)
-                except FMICallException as exc:
-                    raise RuntimeError(f"component {comp.name} failed at t = {t:g} s: {exc}") from None
-                values = dict(zip(comp.real_out, comp.fmu.getReal(comp.real_out_vr)))
-                if comp.bool_out_vr:
-                    values.update(zip(comp.bool_out, comp.fmu.getBoolean(comp.bool_out_vr)))
-                latest[comp.name] = values
-                for name, value in values.items():
-                    record[f"{comp.name}.{name}"][k] = value
-            if progress is not None and k % max(1, n // 100) == 0:
-                progress(k / n)
+        # the record's columns: each component's Real outputs, then its Boolean ones, in stepping order
+        columns = {f"{c.name}.{v}": (c, v) for c in order for v in c.real_out + c.bool_out}
+        values = _steps(order, list(columns), n, step_size, progress)
+        record = {name: values[:, j].astype(bool) if v in c.bool_out else values[:, j]
+                  for j, (name, (c, v)) in enumerate(columns.items())}
         record["time"] = (np.arange(n) + 1) * step_size
         return record
     finally:
@@ -131,6 +119,50 @@ def cosimulate(ssp_path, stop_time: float, step_size: float, progress=None) -> d
             except Exception:  # an instance that never started has nothing to free
                 shutil.rmtree(comp.unzipdir, ignore_errors=True)
         shutil.rmtree(ssp_dir, ignore_errors=True)
+
+
+def _steps(order, columns, n: int, h: float, progress) -> np.ndarray:
+    """n steps of h seconds from 0 of the components in order (Gauss–Seidel): an n × len(columns)
+    record of the outputs "component.variable" (Booleans as 0 or 1), by the C loop
+    (systems.fmi.stepping) in chunks of about 1 %, or, without a C compiler, by _python_steps."""
+    where = {name: j for j, name in enumerate(columns)}
+    record = np.empty((n, len(columns)))
+    lib = stepping.library()
+    if lib is None:
+        return _python_steps(order, where, record, h, progress)
+    stepper = stepping.Stepper(lib, [
+        (c.fmu, c.input_vr, [where[f"{src}.{out}"] for _, src, out in c.inputs], c.real_out_vr,
+         where[f"{c.name}.{c.real_out[0]}"] if c.real_out else 0, c.bool_out_vr,
+         where[f"{c.name}.{c.bool_out[0]}"] if c.bool_out else 0) for c in order])
+    chunk = max(1, n // 100)
+    for first in range(0, n, chunk):
+        done, failed, status = stepper.run(record[first:first + chunk], 0.0, h, first)
+        if failed is not None:
+            raise RuntimeError(f"component {order[failed].name} failed at t = {(first + done) * h:g} s: "
+                               f"status {status} (its log above says why)")
+        if progress is not None:
+            progress(first / n)
+    return record
+
+
+def _python_steps(order, where: dict, record: np.ndarray, h: float, progress) -> np.ndarray:
+    """stepping.c's loop in Python, through fmpy."""
+    n = len(record)
+    for k in range(n):
+        t = k * h
+        for comp in order:
+            if comp.inputs:
+                comp.fmu.setReal(comp.input_vr, [record[k, where[f"{src}.{out}"]] for _, src, out in comp.inputs])
+            try:
+                comp.fmu.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+            except FMICallException as exc:
+                raise RuntimeError(f"component {comp.name} failed at t = {t:g} s: {exc}") from None
+            values = comp.fmu.getReal(comp.real_out_vr) + (comp.fmu.getBoolean(comp.bool_out_vr) if comp.bool_out_vr else [])
+            for name, value in zip(comp.real_out + comp.bool_out, values):
+                record[k, where[f"{comp.name}.{name}"]] = value
+        if progress is not None and k % max(1, n // 100) == 0:
+            progress(k / n)
+    return record
 
 
 def cosimulate_libcosim(ssp_path, stop_time: float, step_size: float, progress=None) -> dict[str, np.ndarray]:

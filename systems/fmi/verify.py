@@ -11,6 +11,14 @@ and `step_rotation` with ideal sensors the RMS error stays below EXACT_BOUND_DEG
 the discrete step is exact for an earth-fixed input. The other estimators' rows are
 reported (bound_deg null). The estimator FMU runs with gyro_offset off: the simulated
 gyros have no offset, and the bounds are the filters' own.
+
+The chain co-simulated is the native one (DIR/native: MotionProfile, ImuSensor and
+AttitudeEstimator in C) where it is built, else the pythonfmu one (DIR). With --python the
+pythonfmu chain runs every configuration too, with the same seeds: each row then reports the
+largest difference between the two estimators' outputs (native_max_diff, over every Real
+output but the Euler angles, derived from q, and every step; native_valid_equal: their `valid`
+agrees at every step), held within CHAIN_TOLERANCE. Each configuration runs the SSP
+`attitude ssp` writes for it (write_verify_ssp), as an independent call (verify_one).
 """
 from __future__ import annotations
 
@@ -28,7 +36,7 @@ from attitude_fmu.blocks.filters.earth_filters import settle_time
 from attitude_fmu.blocks.methods.registry import METHODS
 from attitude_fmu.blocks.methods.registry import method as get_method
 from attitude_fmu.systems.fmi.cosim import cosimulate
-from attitude_fmu.systems.fmi.ssp import write_ssp
+from attitude_fmu.systems.fmi.ssp import CHAINS, COMPONENTS, write_ssp
 from attitude_fmu.systems.simulation.motion import PROFILES
 
 RMS_MARGIN = 1.3  # statistical allowance of a 1200 s run over the analytic RMS
@@ -37,6 +45,8 @@ BIAS_BOUND_DEG = 0.05
 EXACT_BOUND_DEG = 1e-6
 STEP_S = 0.02  # communication step, s
 KERNEL_SETTLE_S = 100.0  # start-up cut for the methods that are not LTI filters, s
+CHAIN_TOLERANCE = 1e-9  # the native and the pythonfmu chain's estimator outputs, with the same seeds
+DERIVED_OUTPUTS = ("estimator.valid", "estimator.roll", "estimator.pitch", "estimator.yaw")  # not held to it
 
 
 @dataclass(frozen=True)
@@ -82,8 +92,23 @@ SCENARIOS = {
 }
 
 
-def verify_one(fmu_dir, profile: str, method: str, workdir, step: float = STEP_S, progress=None) -> dict:
-    """Co-simulate one profile with one method; the row of the verify table."""
+MOTION_SEED = 3  # the motion's seed in every configuration (the sensor's: the scenario's, else ImuSensor's default)
+
+
+def chain_difference(out: dict, other: dict) -> tuple[float, bool]:
+    """The largest difference between the estimator's Real outputs in two co-simulations' records
+    (two chains of the same configuration), and whether its `valid` agrees at every step. The
+    Euler angles are left out: derived from q, which is compared, they are ill-conditioned at
+    pitch ±90° (step_rotation's last step), where 1e-16 of q turns roll and yaw by up to 2π and
+    pitch by 1e-8."""
+    names = [k for k in out if k.startswith("estimator.") and k not in DERIVED_OUTPUTS]
+    diff = max(float(np.abs(out[n] - other[n]).max()) for n in names)
+    return diff, bool((out["estimator.valid"] == other["estimator.valid"]).all())
+
+
+def settle_steps(profile: str, method: str, step: float = STEP_S) -> int:
+    """The steps cut at the start of a configuration before it is measured; ValueError where the
+    scenario is too short to leave as long to measure."""
     scenario = SCENARIOS[profile]
     m = get_method(method)
     settle = scenario.settle_s
@@ -93,32 +118,88 @@ def verify_one(fmu_dir, profile: str, method: str, workdir, step: float = STEP_S
     if start >= int(scenario.duration / step) * 3 // 4:
         raise ValueError(f"{profile}: {scenario.duration:g} s is too short for {method} to settle "
                          f"({start * step:.0f} s) and leave as long to measure")
-    ssp = write_ssp(Path(workdir) / f"{profile}_{method}.ssp", fmu_dir, {
-        "motion": {"profile": profile, "seed": 3},
+    return start
+
+
+def write_verify_ssp(path, fmu_dir, profile: str, method: str, chain: str = "native", step: float = STEP_S) -> Path:
+    """The SSP of one configuration (profile × method), with the FMUs of the chain (native or python)
+    inside: what verify runs, and what `attitude ssp` writes for other tools."""
+    settle_steps(profile, method, step)  # refuses a scenario too short to measure
+    scenario = SCENARIOS[profile]
+    return write_ssp(path, fmu_dir, {
+        "motion": {"profile": profile, "seed": MOTION_SEED},
         "imu": dict(scenario.imu),
         "estimator": {"method": method, "Ts": step, "gyro_offset": "off"},
-    }, scenario.duration, step)
-    out = cosimulate(ssp, scenario.duration, step, progress=progress)
-    q_true = np.column_stack([out[f"motion.qt_{c}"] for c in "wxyz"])[start:]
+    }, scenario.duration, step, chain=chain)
+
+
+def write_verify_ssps(fmu_dir, out, profiles=None, methods=None, chain: str = "native") -> list[Path]:
+    """out/<profile>_<method>.ssp for every profile × method (default: all): `attitude ssp`."""
+    missing = [fmu for fmu, _, _ in COMPONENTS.values() if not (Path(fmu_dir) / CHAINS[chain] / f"{fmu}.fmu").is_file()]
+    if missing:
+        raise RuntimeError(f"the {chain} chain's {', '.join(missing)} FMUs are not built in {Path(fmu_dir) / CHAINS[chain]}"
+                           + (" (the native FMUs need a C compiler; --python takes the pythonfmu ones)"
+                              if chain == "native" else ""))
+    Path(out).mkdir(parents=True, exist_ok=True)
+    return [write_verify_ssp(Path(out) / f"{p}_{m}.ssp", fmu_dir, p, m, chain)
+            for p in profiles or SCENARIOS for m in methods or METHODS]
+
+
+def row_of(out: dict, profile: str, method: str, step: float = STEP_S, lag: int = 0) -> dict:
+    """The verify table's row of a co-simulation's record; lag: the steps by which the estimator's
+    inputs arrive late in the master that ran it (libcosim's: 2), taken off against the truth."""
+    scenario = SCENARIOS[profile]
+    start = settle_steps(profile, method, step)
+    n = len(out["time"]) - lag
+    q_true = np.column_stack([out[f"motion.qt_{c}"] for c in "wxyz"])[start:n]
     up_true = np.column_stack([2 * (q_true[:, 1] * q_true[:, 3] - q_true[:, 0] * q_true[:, 2]),
                                2 * (q_true[:, 2] * q_true[:, 3] + q_true[:, 0] * q_true[:, 1]),
                                1 - 2 * (q_true[:, 1] ** 2 + q_true[:, 2] ** 2)])
-    up_est = np.column_stack([out[f"estimator.g_{c}"] for c in "xyz"])[start:]
+    up_est = np.column_stack([out[f"estimator.g_{c}"] for c in "xyz"])[start + lag:]
     err = np.degrees(inclination_error(up_est, up_true))
     row = {
         "profile": profile, "method": method,
         "rms_deg": rms(err), "max_deg": float(err.max()),
         "mean_deg": math.degrees(bias_angle(up_est, q_true)),
         "metric": scenario.metric, "bound_deg": scenario.bound_deg(profile, method),
-        "valid": bool(out["estimator.valid"][start:].all()),
+        "valid": bool(out["estimator.valid"][start + lag:].all()),
     }
     value = row["rms_deg"] if scenario.metric == "rms" else row["mean_deg"]
     row["pass"] = bool(row["valid"] and (row["bound_deg"] is None or value <= row["bound_deg"]))
     return row
 
 
-def verify(fmu_dir, profiles=None, methods=None, step: float = STEP_S, progress: bool = True) -> list[dict]:
-    """Rows for every profile × method (default: all)."""
+def verify_one(fmu_dir, profile: str, method: str, workdir, step: float = STEP_S, progress=None,
+               chain: str = "native", python: bool = False) -> dict:
+    """Co-simulate one profile with one method (an independent call: a pool can run many at once)
+    on the chain; the row of the verify table. With python (and the native chain), the pythonfmu
+    chain runs the same configuration too: the row then holds the largest difference between the
+    two estimators' outputs (native_max_diff, native_valid_equal) and passes only where both rows
+    pass and that difference is within CHAIN_TOLERANCE."""
+    ssp = write_verify_ssp(Path(workdir) / f"{profile}_{method}_{chain}.ssp", fmu_dir, profile, method, chain, step)
+    out = cosimulate(ssp, SCENARIOS[profile].duration, step, progress=progress)
+    row = {**row_of(out, profile, method, step), "chain": chain, "native_max_diff": None, "native_valid_equal": None}
+    if python and chain == "native":
+        ssp = write_verify_ssp(Path(workdir) / f"{profile}_{method}_python.ssp", fmu_dir, profile, method, "python", step)
+        other = cosimulate(ssp, SCENARIOS[profile].duration, step, progress=progress)
+        row["native_max_diff"], row["native_valid_equal"] = chain_difference(out, other)
+        row["pass"] = bool(row["pass"] and row_of(other, profile, method, step)["pass"] and row["native_valid_equal"]
+                           and row["native_max_diff"] <= CHAIN_TOLERANCE)
+    return row
+
+
+def chain_of(fmu_dir) -> str:
+    """The chain verify runs by default: native where fmu_dir/native has its three FMUs (a C
+    compiler built them), else python."""
+    native = Path(fmu_dir) / CHAINS["native"]
+    return "native" if all((native / f"{fmu}.fmu").is_file() for fmu, _, _ in COMPONENTS.values()) else "python"
+
+
+def verify(fmu_dir, profiles=None, methods=None, step: float = STEP_S, progress: bool = True,
+           python: bool = False) -> list[dict]:
+    """Rows for every profile × method (default: all), on the native chain where it is built
+    (chain_of), with python the pythonfmu chain beside it (verify_one)."""
+    chain = chain_of(fmu_dir)
     profiles = list(profiles or SCENARIOS)
     methods = list(methods or METHODS)
     rows = []
@@ -130,7 +211,7 @@ def verify(fmu_dir, profiles=None, methods=None, step: float = STEP_S, progress:
                 if progress and tty else None
             if progress and not tty:
                 print(f"{label} …", file=sys.stderr, flush=True)
-            rows.append(verify_one(fmu_dir, profile, method, workdir, step, report))
+            rows.append(verify_one(fmu_dir, profile, method, workdir, step, report, chain, python))
             if progress:
                 print(f"\r{label} done", file=sys.stderr, flush=True)
     return rows

@@ -15,6 +15,7 @@ from attitude_fmu.blocks.stages.heading import heading_system
 from attitude_fmu.blocks.stages.heading import initial_state as heading_initial_state
 from attitude_fmu.blocks.stages.timing import latency_system
 from attitude_fmu.systems.simulation.motion import AXES, EARTH_FIELD_UT, HumanMotion
+from attitude_fmu.systems.simulation.noise import MAGNETOMETER, MOTION, SENSOR, normals
 from attitude_fmu.systems.simulation.sensor_model import ImuModel
 
 NOISE_INPUTS = [f"eps_{s}_{a}" for s in "vw" for a in AXES] + [f"{s}_{a}" for s in ("n", "na") for a in AXES]
@@ -90,9 +91,12 @@ def simulate_closed_loop(motion: HumanMotion, imu: ImuModel, fs: float, duration
                          method: str = "wiener", params: dict | None = None, seed: int = 0,
                          gyro_offset: bool = True, heading: bool = False, latency: float = 0.0):
     """Short run of the diagram (see closed_loop) with fixed-seed noise: (noise N×12, or
-    N×15 with heading; response)."""
+    N×15 with heading; response). The noise is that of HumanMotion.generate, ImuModel.apply
+    and ImuModel.apply_mag with the same seed (systems.simulation.noise's streams MOTION,
+    SENSOR and MAGNETOMETER)."""
     diagram, x0 = closed_loop(motion, imu, fs, method, params, gyro_offset, heading, latency)
     n = int(round(duration * fs))
-    noise = np.random.default_rng(seed).standard_normal((n, diagram.ninputs))
+    streams = (MOTION, SENSOR, MAGNETOMETER) if heading else (MOTION, SENSOR)
+    noise = np.hstack([normals(seed, stream, n) for stream in streams])
     t = np.arange(n) / fs
     return noise, control.input_output_response(diagram, t, noise.T, X0=x0)

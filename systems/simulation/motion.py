@@ -18,6 +18,7 @@ from attitude_fmu.blocks.filters.earth_filters import STANDARD_GRAVITY
 from attitude_fmu.blocks.jit import kernel
 from attitude_fmu.blocks.params import Param
 from attitude_fmu.blocks.quaternion import quat_multiply, quat_normalized, quat_rotate, rotvec_quat
+from attitude_fmu.systems.simulation.noise import MOTION, NoiseStream, normals
 
 AXES = ("x", "y", "z")
 EARTH_FIELD_UT = (0.0, 20.0, -45.0)  # magnetic field in ENU, µT: northwards and down
@@ -87,11 +88,12 @@ class HumanMotion:
         ])
 
     def generate(self, duration: float, fs: float, seed: int = 0) -> Motion:
-        """Sample duration (s) at fs (Hz) from a fixed seed; starts level, at rest."""
+        """Sample duration (s) at fs (Hz) from a fixed seed (the noise stream MOTION of
+        systems.simulation.noise); starts level, at rest."""
         n = int(round(duration * fs))
         if n < 1:
             raise ValueError(f"duration·fs must give at least one sample, got {duration!r}·{fs!r}")
-        noise = np.random.default_rng(seed).standard_normal((n, 6))
+        noise = normals(seed, MOTION, n)
         state = np.zeros(10)
         state[6] = 1.0
         out = np.empty((n, 10))
@@ -153,7 +155,7 @@ class HumanStream:
 
     def __init__(self, motion: HumanMotion, seed: int = 0):
         self.motion = motion
-        self.rng = np.random.default_rng(seed)
+        self.noise = NoiseStream(seed, MOTION)
         self.state = motion.initial_state()
         self._out = np.empty((1, 10))
         self._h = None
@@ -162,7 +164,7 @@ class HumanStream:
         """Ideal (gyr, specific force, quat) for the interval (t − h, t]."""
         if h != self._h:
             self._coef, self._h = self.motion.coefficients(1.0 / h), h
-        _human_run(self.state, self.rng.standard_normal((1, 6)), self._coef, self._out)
+        _human_run(self.state, self.noise.next().reshape(1, 6), self._coef, self._out)
         return self._out[0, 0:3], self._out[0, 3:6], self._out[0, 6:10]
 
 

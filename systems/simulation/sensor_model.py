@@ -8,12 +8,7 @@ import control
 import numpy as np
 
 from attitude_fmu.systems.simulation.motion import AXES, Motion
-
-
-def mag_noise_generator(seed: int) -> np.random.Generator:
-    """The magnetometer's noise stream for seed: one of its own, so that the gyro's and the
-    accelerometer's noise (default_rng(seed)) do not depend on the magnetometer's settings."""
-    return np.random.default_rng((seed, 1))
+from attitude_fmu.systems.simulation.noise import MAGNETOMETER, SENSOR, normals
 
 
 @dataclass(frozen=True)
@@ -97,14 +92,17 @@ class ImuModel:
         return signals[:, 0:3], signals[:, 3:6]
 
     def apply(self, motion: Motion, seed: int = 1) -> tuple[np.ndarray, np.ndarray]:
-        """Measured (gyr, acc) of a motion, with noise drawn from a fixed seed (with a
-        latency, of the motion that long ago: delayed)."""
-        noise = np.random.default_rng(seed).standard_normal((len(motion.gyr), 6))
+        """Measured (gyr, acc) of a motion, with noise drawn from a fixed seed (the noise
+        stream SENSOR of systems.simulation.noise; with a latency, of the motion that long
+        ago: delayed)."""
+        noise = normals(seed, SENSOR, len(motion.gyr))
         return self.measure(*self.delayed(motion.gyr, motion.acc, motion.fs), noise, motion.fs)
 
     def apply_mag(self, motion: Motion, seed: int = 1) -> np.ndarray:
-        """Measured field (N×3, µT) of a motion, noise from mag_noise_generator(seed)."""
-        return self.measure_mag(motion.mag, mag_noise_generator(seed).standard_normal((len(motion.gyr), 3)), motion.fs)
+        """Measured field (N×3, µT) of a motion, noise from the magnetometer's own stream
+        (MAGNETOMETER of systems.simulation.noise), so that the gyro's and the accelerometer's
+        noise do not depend on the magnetometer's settings."""
+        return self.measure_mag(motion.mag, normals(seed, MAGNETOMETER, len(motion.gyr)), motion.fs)
 
     def system(self, fs: float, name: str = "imu"):
         """Discrete python-control system: inputs omega_*, f_*, n_*, na_* (unit normal);

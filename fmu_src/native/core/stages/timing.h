@@ -1,0 +1,36 @@
+/* timing.h: sample timing: the gyro's and the accelerometer's sample conventions, latency
+ * compensation, and when two sample times are one.
+ * Python twin: blocks/stages/timing.py (same names). Units: rad/s, m/s^2, s. */
+#ifndef AF_TIMING_H
+#define AF_TIMING_H
+
+#include <stddef.h>
+
+#include "quaternion.h"
+
+/* relative difference below which two sample times are one (a master's rounding noise) */
+#define STEP_TOLERANCE 1e-9
+#define MAX_LATENCY_S 0.5 /* s: the gyro's last rate is no guide to the orientation further ahead */
+
+/* 0, or -1 with Python's message unless gyr_samples is "mean" or "point" and acc_samples
+ * "point" or "mean". */
+int check_samples(const char *gyr_samples, const char *acc_samples, char *message, size_t size);
+
+/* Whether the sample time Ts (s) is reference (s) up to STEP_TOLERANCE. */
+int same_step(double Ts, double reference);
+
+/* The mean rate over the sample time between two point samples of it (rad/s): the trapezoid. */
+Vec3 interval_mean(Vec3 before, Vec3 now);
+
+/* 0, or -1 with Python's message unless latency (s) is finite and within +-MAX_LATENCY_S. */
+int check_latency(double latency, char *message, size_t size);
+
+/* q (sensor -> earth) carried forward over latency (s) at the rate gyr (rad/s), q (x) exp(gyr
+ * latency), into *q_out; and up (any length) in the sensor frame latency seconds later, into *up_out. */
+void carry_forward(Quat q, Vec3 up, Vec3 gyr, double latency, Quat *q_out, Vec3 *up_out);
+
+/* acc (m/s^2), a mean over the sample time Ts (s), in the sensor frame at its end: turned as
+ * carry_forward turns the up-vector over Ts/2 at the sample's mean rate gyr (rad/s). */
+Vec3 interval_end(Vec3 gyr, Vec3 acc, double Ts);
+
+#endif

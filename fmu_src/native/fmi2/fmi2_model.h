@@ -1,0 +1,89 @@
+/* fmi2_model.h: what a model gives the FMI 2.0 co-simulation plumbing of this folder, and what it
+ * gets from it.
+ *
+ * The plumbing knows nothing of what a model computes. It holds the instance, the values of the
+ * model's variables and the FMI state machine; it checks every call against the FMI 2.0 standard
+ * (a call in a state that does not allow it, a value reference of another type, a set the
+ * variable's causality and variability forbid: fmi2Error with a log message), saves and
+ * serialises FMU states, and logs through the importer's callback. A model file (models/<Name>.c)
+ * defines `fmi2_model`: its variables (a table generated from the project's table of FMU
+ * variables, fmu_src/variables.py, into <Name>_variables.h), the size of its own state and two
+ * functions, called at fmi2ExitInitializationMode and at each fmi2DoStep. */
+#ifndef FMI2_MODEL_H
+#define FMI2_MODEL_H
+
+#include <stddef.h>
+
+#include "fmi2Functions.h"
+
+typedef enum { FMI2_REAL, FMI2_INTEGER, FMI2_BOOLEAN, FMI2_STRING } Fmi2Type;
+typedef enum { FMI2_PARAMETER, FMI2_CALCULATED_PARAMETER, FMI2_INPUT, FMI2_OUTPUT, FMI2_LOCAL, FMI2_INDEPENDENT }
+    Fmi2Causality;
+typedef enum { FMI2_CONSTANT, FMI2_FIXED, FMI2_TUNABLE, FMI2_DISCRETE, FMI2_CONTINUOUS } Fmi2Variability;
+typedef enum { FMI2_INITIAL_UNSET, FMI2_EXACT, FMI2_APPROX, FMI2_CALCULATED } Fmi2Initial;
+
+#define FMI2_STRING_SIZE 256   /* bytes a String variable holds, its terminating 0 included */
+#define FMI2_MAX_CATEGORIES 32 /* log categories a model may have */
+
+/* One variable of the model description. */
+typedef struct {
+    const char *name;
+    Fmi2Type type;
+    Fmi2Causality causality;
+    Fmi2Variability variability;
+    Fmi2Initial initial;
+    size_t index;             /* its place among the values of its type (Fmi2Instance.reals, ...) */
+    double start;             /* the start value of a Real, Integer (whole) or Boolean (0 or 1) */
+    const char *start_string; /* the start value of a String; NULL for the other types */
+} Fmi2Variable;
+
+typedef struct Fmi2Instance Fmi2Instance;
+
+typedef struct {
+    const char *identifier;          /* the model identifier */
+    const char *guid;                /* the model description's guid */
+    const Fmi2Variable *variables;   /* indexed by value reference, 0 ... n_variables - 1 */
+    size_t n_variables;
+    size_t n_reals, n_integers, n_booleans, n_strings;
+    const char *const *log_categories; /* the model description's LogCategories */
+    size_t n_log_categories;
+    size_t state_size;               /* bytes of the model's own state: plain data, copied into FMU states */
+    /* fmi2ExitInitializationMode: build the model from its parameters. fmi2OK, fmi2Warning, or
+     * fmi2Error with a logged message (an invalid parameter). */
+    fmi2Status (*initialise)(Fmi2Instance *instance);
+    /* fmi2DoStep from t over h seconds (h > 0, finite): inputs read, outputs written. */
+    fmi2Status (*step)(Fmi2Instance *instance, fmi2Real t, fmi2Real h);
+} Fmi2Model;
+
+extern const Fmi2Model fmi2_model; /* defined by the model file */
+
+/* An instance as a model sees it: the values of its variables, by Fmi2Variable.index within each
+ * type, and its own state, all zero after fmi2Instantiate and fmi2Reset but for the values, which
+ * start at their start values. The plumbing's own fields follow (fmi2/instance.h). */
+struct Fmi2Instance {
+    fmi2Real *reals;
+    fmi2Integer *integers;
+    fmi2Boolean *booleans;
+    char (*strings)[FMI2_STRING_SIZE];
+    void *state;
+    /* the plumbing's */
+    unsigned char *data;      /* one block: reals, integers, booleans, strings, state */
+    size_t data_size;
+    int phase;                /* Fmi2Phase (fmi2/instance.h) */
+    char *name;               /* the instance name, copied */
+    fmi2CallbackFunctions callbacks;
+    int debug;                /* debug logging on */
+    unsigned long categories; /* bit k: category k of log_categories on */
+    fmi2Status logged;        /* the most severe status logged during the current call */
+};
+
+/* Log a message (printf format) with the status's category (logStatusWarning, logStatusError, ...):
+ * warnings and errors always reach the importer's logger, fmi2OK messages only with debug logging
+ * on for the category. The call that logs it returns at least status. */
+void fmi2_log(Fmi2Instance *instance, fmi2Status status, const char *format, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+#endif

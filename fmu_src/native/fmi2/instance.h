@@ -1,0 +1,50 @@
+/* instance.h: an FMU instance of the plumbing: its life (instantiate, reset, free), the FMI 2.0
+ * co-simulation state machine and the logging through the importer's callback. */
+#ifndef FMI2_INSTANCE_H
+#define FMI2_INSTANCE_H
+
+#include "fmi2_model.h"
+
+/* The states of the FMI 2.0 co-simulation state machine this plumbing goes through (steps are
+ * synchronous: none is ever in progress, failed or cancelled). Any call that returns fmi2Error
+ * leaves the instance in FMI2_ERROR, from which fmi2Reset, fmi2SetFMUstate or fmi2FreeInstance
+ * lead on. */
+typedef enum {
+    FMI2_INSTANTIATED,
+    FMI2_INITIALIZATION_MODE,
+    FMI2_STEP_COMPLETE,
+    FMI2_TERMINATED,
+    FMI2_ERROR,
+    FMI2_N_PHASES
+} Fmi2Phase;
+
+#define FMI2_IN(phase) (1u << (phase))
+#define FMI2_ANY_PHASE ((1u << FMI2_N_PHASES) - 1u)
+
+/* A new instance with its values at their start values, or NULL (logged through functions). */
+Fmi2Instance *fmi2_instance_new(fmi2String name, const fmi2CallbackFunctions *functions, fmi2Boolean logging_on);
+void fmi2_instance_free(Fmi2Instance *instance);
+/* Back to FMI2_INSTANTIATED: start values, the model's state zero. */
+void fmi2_instance_reset(Fmi2Instance *instance);
+
+/* The start of a call: 1 if the instance's state allows it (allowed: FMI2_IN bits), else 0 with
+ * an error logged and the instance in FMI2_ERROR. Traces the call (category logCalls). */
+int fmi2_enter(Fmi2Instance *instance, const char *call, unsigned allowed);
+/* The end of a call: status raised to what the call logged; fmi2Error or worse leaves the
+ * instance in FMI2_ERROR. */
+fmi2Status fmi2_leave(Fmi2Instance *instance, fmi2Status status);
+
+/* Turn debug logging on or off for the named categories (all for n == 0); an unknown name is
+ * logged as a warning. */
+void fmi2_set_debug_logging(Fmi2Instance *instance, fmi2Boolean on, size_t n, const fmi2String categories[]);
+
+/* Log through functions before an instance exists (fmi2Instantiate's refusals). */
+void fmi2_log_to(const fmi2CallbackFunctions *functions, fmi2String name, fmi2Status status, const char *format, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 4, 5)))
+#endif
+    ;
+
+const char *fmi2_phase_name(int phase);
+
+#endif

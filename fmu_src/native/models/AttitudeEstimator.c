@@ -1,0 +1,120 @@
+/* AttitudeEstimator.c: the model of the native AttitudeEstimator.fmu: its variables
+ * (AttitudeEstimator_variables.h, generated from fmu_src/variables.py) onto the C core's online
+ * estimator (core/pipeline/online.h).
+ * Python twin: fmu_src/AttitudeEstimator.py (the same checks, messages and statuses). */
+#include <math.h>
+#include <string.h>
+
+#include "AttitudeEstimator_variables.h"
+#include "messages.h"
+#include "pipeline/online.h"
+#include "stages/timing.h"
+
+#define MESSAGE_SIZE 1024
+
+typedef struct {
+    AfOnline estimator;
+    int warned_step; /* a step size other than Ts was logged (once: a master with variable steps would log each) */
+} Model;
+
+static const Fmi2Variable *variable_named(const char *name) {
+    for (size_t vr = 0; vr < N_VARIABLES; vr++)
+        if (strcmp(MODEL_VARIABLES[vr].name, name) == 0) return &MODEL_VARIABLES[vr];
+    return NULL;
+}
+
+/* a String parameter that must be one of two words */
+static int either(Fmi2Instance *instance, const char *name, const char *value, const char *one, const char *other) {
+    if (strcmp(value, one) == 0 || strcmp(value, other) == 0) return 1;
+    char repr[FMI2_STRING_SIZE + 8];
+    fmi2_log(instance, fmi2Error, "invalid parameter: %s must be '%s' or '%s', got %s", name, one, other,
+             str_repr(value, repr, sizeof repr));
+    return 0;
+}
+
+static fmi2Status initialise(Fmi2Instance *instance) {
+    Model *model = instance->state;
+    const fmi2Real *r = instance->reals;
+    char message[MESSAGE_SIZE], repr[FLOAT_REPR_SIZE];
+    if (!(isfinite(r[REAL_Ts]) && r[REAL_Ts] > 0.0)) {
+        fmi2_log(instance, fmi2Error, "invalid parameter: Ts must be a finite positive number of seconds, got %s",
+                 float_repr(r[REAL_Ts], repr));
+        return fmi2Error;
+    }
+    if (!either(instance, "heading", instance->strings[STRING_heading], "mag", "gyro") ||
+        !either(instance, "gyro_offset", instance->strings[STRING_gyro_offset], "on", "off"))
+        return fmi2Error;
+    AfConfig config = {
+        .method = instance->strings[STRING_method],
+        .heading = strcmp(instance->strings[STRING_heading], "mag") == 0,
+        .gyro_offset = strcmp(instance->strings[STRING_gyro_offset], "on") == 0,
+        .latency = r[REAL_latency],
+        .gyr_samples = instance->strings[STRING_gyr_samples],
+        .acc_samples = instance->strings[STRING_acc_samples],
+    };
+    /* given: the tuning parameters whose values differ from their start values (NaN: unset) */
+    for (int k = 0; k < AF_N_PARAMS; k++) {
+        const Fmi2Variable *v = variable_named(AF_PARAMS[k].name);
+        if (!v || v->type != FMI2_REAL) {
+            fmi2_log(instance, fmi2Error, "the tuning parameter %s has no Real variable", AF_PARAMS[k].name);
+            return fmi2Error;
+        }
+        double value = r[v->index];
+        config.params[k] = isnan(value) || value == v->start ? NAN : value;
+    }
+    if (af_online_init(&model->estimator, &config, message, sizeof message) != 0 ||
+        af_online_discretise(&model->estimator, r[REAL_Ts], message, sizeof message) != 0) {
+        fmi2_log(instance, fmi2Error, "invalid parameter: %s", message);
+        return fmi2Error;
+    }
+    model->warned_step = 0;
+    return fmi2OK;
+}
+
+static void put(fmi2Real *to, const double *from, int n) {
+    for (int i = 0; i < n; i++) to[i] = from[i];
+}
+
+static fmi2Status step(Fmi2Instance *instance, fmi2Real t, fmi2Real h) {
+    Model *model = instance->state;
+    AfOnline *est = &model->estimator;
+    fmi2Real *r = instance->reals;
+    fmi2Status status = fmi2OK;
+    if (!model->warned_step && !same_step(h, r[REAL_Ts])) {
+        model->warned_step = 1;
+        fmi2_log(instance, fmi2Warning, "communication step %g s differs from Ts = %g s: filter re-discretised for it "
+                 "(and, without further warnings, for every other step size)", h, r[REAL_Ts]);
+        status = fmi2Warning;
+    }
+    /* each vector's components are consecutive in the table: x, y, z (w, x, y, z) */
+    const double gyr[3] = {r[REAL_gyr_x], r[REAL_gyr_y], r[REAL_gyr_z]};
+    const double acc[3] = {r[REAL_acc_x], r[REAL_acc_y], r[REAL_acc_z]};
+    const double mag[3] = {r[REAL_mag_x], r[REAL_mag_y], r[REAL_mag_z]};
+    char message[MESSAGE_SIZE];
+    int taken = af_online_step(est, gyr, acc, mag, h, message, sizeof message);
+    if (taken < 0) {
+        fmi2_log(instance, fmi2Error, "%s", message);
+        return fmi2Error;
+    }
+    instance->booleans[BOOLEAN_valid] = taken == 1;
+    if (taken == 1) {
+        put(&r[REAL_q_w], est->quat, 4);
+        put(&r[REAL_g_x], est->up, 3);
+        put(&r[REAL_roll], est->euler, 3);
+        put(&r[REAL_gyr_offset_x], est->offset, 3);
+        put(&r[REAL_mag_offset_x], est->mag_offset, 3);
+        r[REAL_mag_delay_used] = est->mag_delay;
+    } else if (!valid_sample(gyr, acc)) {
+        int finite = 1;
+        for (int i = 0; i < 3; i++) finite = finite && isfinite(gyr[i]) && isfinite(acc[i]);
+        fmi2_log(instance, fmi2Warning, "t=%g: %s; estimate held", t,
+                 finite ? "input beyond every IMU's range" : "non-finite input");
+        status = fmi2Warning;
+    }
+    return status;
+}
+
+const Fmi2Model fmi2_model = {
+    MODEL_IDENTIFIER, MODEL_GUID, MODEL_VARIABLES, N_VARIABLES, N_REALS, N_INTEGERS, N_BOOLEANS, N_STRINGS,
+    MODEL_LOG_CATEGORIES, N_LOG_CATEGORIES, sizeof(Model), initialise, step,
+};

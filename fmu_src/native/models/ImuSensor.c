@@ -1,0 +1,85 @@
+/* ImuSensor.c: the model of the native ImuSensor.fmu: its variables (ImuSensor_variables.h,
+ * generated from fmu_src/simulation_variables.py) onto the simulation's sensor model (sim/sensor.h),
+ * delay line (sim/delay_line.h) and noise streams (sim/noise.h): step k draws sample k of the
+ * streams SENSOR and MAGNETOMETER of `seed`, as ImuModel.apply and apply_mag draw them.
+ * Python twin: fmu_src/ImuSensor.py (the same checks, messages and statuses). */
+#include <stdint.h>
+
+#include "ImuSensor_variables.h"
+#include "messages.h"
+#include "sim/delay_line.h"
+#include "sim/noise.h"
+#include "sim/sensor.h"
+#include "stages/timing.h"
+
+#define MESSAGE_SIZE 512
+
+typedef struct {
+    ImuParams params;
+    uint64_t seed, k; /* the noise streams' seed; the steps taken */
+    double step_size; /* the first step's, s: a latency needs a fixed step */
+    DelayLine delay;
+} Model;
+
+static void copy3(double to[3], const fmi2Real *from) {
+    for (int i = 0; i < 3; i++) to[i] = from[i];
+}
+
+static fmi2Status initialise(Fmi2Instance *instance) {
+    Model *model = instance->state;
+    const fmi2Real *r = instance->reals;
+    ImuParams *p = &model->params;
+    char message[MESSAGE_SIZE];
+    /* each vector's components are consecutive in the table: x, y, z; gyr_scale_<row>_<c> row by row */
+    p->delta_n = r[REAL_delta_n];
+    copy3(p->gyr_offset, &r[REAL_gyr_offset_x]);
+    for (int i = 0; i < 9; i++) p->gyr_scale[i] = r[REAL_gyr_scale_x_x + i];
+    p->acc_noise = r[REAL_acc_noise];
+    copy3(p->acc_offset, &r[REAL_acc_offset_x]);
+    p->latency = r[REAL_latency];
+    p->mag_noise = r[REAL_mag_noise];
+    copy3(p->mag_offset, &r[REAL_mag_offset_x]);
+    if (imu_check(p, message, sizeof message) != 0 ||
+        check_seed(instance->integers[INTEGER_seed], &model->seed, message, sizeof message) != 0) {
+        fmi2_log(instance, fmi2Error, "invalid parameter: %s", message);
+        return fmi2Error;
+    }
+    model->k = 0;
+    return fmi2OK;
+}
+
+static fmi2Status step(Fmi2Instance *instance, fmi2Real t, fmi2Real h) {
+    (void)t;
+    Model *model = instance->state;
+    fmi2Real *r = instance->reals;
+    double signals[DELAY_WIDTH], late[DELAY_WIDTH], noise[SENSOR_WIDTH], mag_noise[MAGNETOMETER_WIDTH];
+    for (int i = 0; i < 3; i++) signals[i] = r[REAL_omega_x + i], signals[3 + i] = r[REAL_f_x + i];
+    const double *measured = signals;
+    if (model->params.latency) {
+        char message[MESSAGE_SIZE], a[FLOAT_REPR_SIZE], b[FLOAT_REPR_SIZE];
+        if (model->k == 0) {
+            if (delay_init(&model->delay, model->params.latency, 1.0 / h, signals, message, sizeof message) != 0) {
+                fmi2_log(instance, fmi2Error, "%s", message);
+                return fmi2Error;
+            }
+            model->step_size = h;
+        } else if (!same_step(h, model->step_size)) {
+            fmi2_log(instance, fmi2Error, "latency needs a fixed step: got %s s after %s s", float_repr(h, a),
+                     float_repr(model->step_size, b));
+            return fmi2Error;
+        }
+        delay_step(&model->delay, signals, late);
+        measured = late;
+    }
+    noise_normals(model->seed, SENSOR, model->k, SENSOR_WIDTH, noise);
+    imu_measure(&model->params, measured, measured + 3, noise, 1.0 / h, &r[REAL_gyr_x], &r[REAL_acc_x]);
+    noise_normals(model->seed, MAGNETOMETER, model->k, MAGNETOMETER_WIDTH, mag_noise);
+    imu_measure_mag(&model->params, &r[REAL_m_x], mag_noise, 1.0 / h, &r[REAL_mag_x]);
+    model->k++;
+    return fmi2OK;
+}
+
+const Fmi2Model fmi2_model = {
+    MODEL_IDENTIFIER, MODEL_GUID, MODEL_VARIABLES, N_VARIABLES, N_REALS, N_INTEGERS, N_BOOLEANS, N_STRINGS,
+    MODEL_LOG_CATEGORIES, N_LOG_CATEGORIES, sizeof(Model), initialise, step,
+};

@@ -1,0 +1,101 @@
+/* closed_form.c: Python twin systems/simulation/motion.py (ClosedFormMotion.at and the closed-form
+ * profiles). scipy's Rotation there is quaternion algebra here: the same products in the same
+ * order, so the quaternions carry the same sign. */
+#include "sim/closed_form.h"
+
+#include <math.h>
+
+#include "quaternion.h"
+
+#define PI 3.141592653589793
+#define STEP_LEVELS 10 /* STEP_SIZES_DEG, each followed by 0 */
+static const double STEP_SIZES_DEG[STEP_LEVELS / 2] = {5.0, 10.0, 20.0, 45.0, 90.0};
+
+static double radians(double degrees) { return degrees * (PI / 180.0); }
+
+/* the rotation about a coordinate axis (0 x, 1 y, 2 z) by angle (rad): motion.py's _rot */
+static Quat rot(int axis, double angle) {
+    return rotvec_quat(axis == 0 ? angle : 0.0, axis == 1 ? angle : 0.0, axis == 2 ? angle : 0.0);
+}
+
+/* Rotation.from_euler("xy", [a, b], degrees=True): about the fixed x, then the fixed y */
+static Quat extrinsic_xy(double a_deg, double b_deg) { return quat_multiply(rot(1, radians(b_deg)), rot(0, radians(a_deg))); }
+
+/* Rotation.from_euler("XYZ", [a, b, c], degrees=True): about x, then the new y, then the new z */
+static Quat intrinsic_xyz(double a_deg, double b_deg, double c_deg) {
+    return quat_multiply(quat_multiply(rot(0, radians(a_deg)), rot(1, radians(b_deg))), rot(2, radians(c_deg)));
+}
+
+/* step_rotation's level i (rad): STEP_SIZES_DEG, each followed by 0, repeated (i of any sign) */
+static double step_level(long i) {
+    long n = (i % STEP_LEVELS + STEP_LEVELS) % STEP_LEVELS;
+    return n % 2 ? 0.0 : radians(STEP_SIZES_DEG[n / 2]);
+}
+
+/* step_rotation's pitch (rad) at t */
+static double step_pitch(double hold, double ramp, double t) {
+    double i = floor(t / hold);
+    double into = t - i * hold;
+    double now = step_level((long)i), before = step_level((long)i - 1);
+    double blend = into < ramp ? 0.5 - 0.5 * cos(PI * fmin(fmax(into / ramp, 0.0), 1.0)) : 1.0;
+    return t < hold ? now * blend : before + (now - before) * blend;
+}
+
+static Quat orientation(const ClosedForm *m, double t) {
+    const double *p = m->p;
+    switch (m->profile) {
+    case LEVER_ARM: return quat_multiply(rot(2, p[0] * t), extrinsic_xy(20.0, -10.0));
+    case INCLINE: return quat_normalized(rot(1, radians(-p[0])));
+    case CONING: return quat_multiply(quat_multiply(rot(2, p[1] * t), rot(0, p[0])), rot(2, -p[1] * t));
+    case SINE_ROTATION:
+        return quat_multiply(rot(1, radians(p[0]) * sin(2 * PI * p[1] * t)), rot(0, radians(p[2])));
+    case STEP_ROTATION: return rot(1, step_pitch(p[0], p[1], t));
+    case LINEAR_MOTION: return quat_normalized(intrinsic_xyz(p[2], p[3], p[4]));
+    case OFFSET_ROTATION:
+        return quat_multiply(rot(2, radians(p[1]) * sin(2 * PI * p[0] * t)), extrinsic_xy(p[3], p[4]));
+    default: return (Quat){NAN, NAN, NAN, NAN};
+    }
+}
+
+static Vec3 velocity(const ClosedForm *m, double t) {
+    const double *p = m->p;
+    switch (m->profile) {
+    case LEVER_ARM: return (Vec3){p[0] * p[1] * -sin(p[0] * t), p[0] * p[1] * cos(p[0] * t), 0.0};
+    case INCLINE: {
+        double w = 2 * PI * p[2], amplitude = p[1] * m->g / w;
+        Vec3 along = quat_rotate(rot(1, radians(-p[0])), (Vec3){1.0, 0.0, 0.0});
+        double s = -amplitude * cos(w * t);
+        return (Vec3){s * along.x, s * along.y, s * along.z};
+    }
+    case LINEAR_MOTION: {
+        double w = 2 * PI / p[1];
+        return (Vec3){p[0] * w / 2 * sin(w * t), 0.0, 0.0};
+    }
+    case OFFSET_ROTATION: {
+        double amp = radians(p[1]), w = 2 * PI * p[0];
+        double psi = amp * sin(w * t), psi_dot = amp * w * cos(w * t);
+        return (Vec3){p[2] * (-sin(psi) * psi_dot), p[2] * (cos(psi) * psi_dot), 0.0};
+    }
+    default: return (Vec3){0.0, 0.0, 0.0}; /* fixed in position */
+    }
+}
+
+/* Rotation.as_rotvec: the rotation vector (rad) of q, taken with w >= 0 */
+static Vec3 rotvec(Quat q) {
+    if (q.w < 0.0) q = (Quat){-q.w, -q.x, -q.y, -q.z};
+    double angle = 2.0 * atan2(sqrt(q.x * q.x + q.y * q.y + q.z * q.z), q.w);
+    double angle2 = angle * angle;
+    double scale = angle <= 1e-3 ? 2.0 + angle2 / 12.0 + 7.0 * angle2 * angle2 / 2880.0 : angle / sin(angle / 2.0);
+    return (Vec3){scale * q.x, scale * q.y, scale * q.z};
+}
+
+void closed_form_at(const ClosedForm *m, double t, double h, double gyr[3], double f[3], double quat[4]) {
+    Quat now = orientation(m, t), before = orientation(m, t - h);
+    Vec3 r = rotvec(quat_multiply(quat_conjugate(before), now));
+    gyr[0] = r.x / h, gyr[1] = r.y / h, gyr[2] = r.z / h;
+    Vec3 v = velocity(m, t), v0 = velocity(m, t - h);
+    Vec3 acc = {(v.x - v0.x) / h, (v.y - v0.y) / h, (v.z - v0.z) / h + m->g};
+    Vec3 sensor = quat_rotate(quat_conjugate(now), acc);
+    f[0] = sensor.x, f[1] = sensor.y, f[2] = sensor.z;
+    quat[0] = now.w, quat[1] = now.x, quat[2] = now.y, quat[3] = now.z;
+}

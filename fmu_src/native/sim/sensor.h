@@ -1,0 +1,27 @@
+/* sensor.h: the IMU sensor model, ideal motion signals in, measured signals out (Rizun eqs. 1-2):
+ * gyro y_g = (I + S) omega + n + b, accelerometer y_a = f + n_a + acc_offset, magnetometer
+ * y_m = m + n_m + mag_offset; white noise of one-sided densities, per-sample s.d. density*sqrt(fs/2).
+ * Python twin: systems/simulation/sensor_model.py (ImuModel: __post_init__, measure, measure_mag). */
+#ifndef SIM_SENSOR_H
+#define SIM_SENSOR_H
+
+#include <stddef.h>
+
+/* delta_n: gyro noise density, rad/s/sqrt(Hz); gyr_offset: b, rad/s; gyr_scale: S, row-major (row
+ * i: what axis i adds of each true rate component); acc_noise: m/s^2/sqrt(Hz); acc_offset: m/s^2;
+ * latency: how long gyr and acc lag the motion, s (sim/delay_line.h); mag_noise: uT/sqrt(Hz);
+ * mag_offset: hard iron, uT */
+typedef struct {
+    double delta_n, gyr_offset[3], gyr_scale[9], acc_noise, acc_offset[3], latency, mag_noise, mag_offset[3];
+} ImuParams;
+
+/* ImuModel's refusals: 0, or -1 with the message. */
+int imu_check(const ImuParams *p, char *message, size_t size);
+/* measured gyr (rad/s) and acc (m/s^2) from the true rate omega, specific force f and 6 unit normals
+ * (gyro, then accelerometer) at sample rate fs (Hz) */
+void imu_measure(const ImuParams *p, const double omega[3], const double f[3], const double noise[6], double fs,
+                 double gyr[3], double acc[3]);
+/* measured field (uT) from the true field m (uT, sensor coordinates) and 3 unit normals */
+void imu_measure_mag(const ImuParams *p, const double m[3], const double noise[3], double fs, double mag[3]);
+
+#endif

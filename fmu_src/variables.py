@@ -1,0 +1,165 @@
+"""The FMUs' variables: one table per interface, a row per variable (name, type, causality,
+variability, initial, unit, start value, description, value reference).
+
+Every model description of an interface is written from its table
+(fmu_src.model_description): the pythonfmu FMU registers its variables from it
+(fmu_support.ProjectSlave), the native FMU's modelDescription.xml and C header are
+generated from it (systems.fmi.native). So one FMU can take the other's place in an SSP or
+a master's script: same names, causalities, units, start values and value references.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import cache
+
+from attitude_fmu.blocks.methods.registry import METHODS
+from attitude_fmu.blocks.pipeline.causal import ESTIMATORS
+
+REAL, INTEGER, BOOLEAN, STRING = "Real", "Integer", "Boolean", "String"
+IN, OUT, PAR = "input", "output", "parameter"
+
+# FMI unit name → SI base-unit exponents (FMI 2.0 BaseUnit attributes); None for the
+# noise densities per √Hz, whose half-integer exponents FMI 2.0 cannot state
+UNITS = {
+    "s": {"s": 1},
+    "Hz": {"s": -1},
+    "m": {"m": 1},
+    "rad": {"rad": 1},
+    "deg": {"rad": 1, "factor": 0.017453292519943295},
+    "rad/s": {"rad": 1, "s": -1},
+    "1/s": {"s": -1},
+    "1/s2": {"s": -2},
+    "rad/s/sqrt(Hz)": None,
+    "m/s/sqrt(Hz)": None,
+    "m/s2/sqrt(Hz)": None,
+    "m/s2": {"m": 1, "s": -2},
+    "uT": {"kg": 1, "s": -2, "A": -1, "factor": 1e-6},
+    "uT/sqrt(Hz)": None,
+    "1": {},
+}
+
+
+def fmi_unit(unit: str) -> str:
+    """The FMI unit name of a unit as the project documents it ("m/s²" → "m/s2", "√Hz" → "sqrt(Hz)")."""
+    name = unit.replace("√Hz", "sqrt(Hz)").replace("²", "2")
+    if name not in UNITS:
+        raise ValueError(f"unit {unit!r} has no FMI definition in fmu_src.variables.UNITS")
+    return name
+
+
+@dataclass(frozen=True)
+class Variable:
+    """One FMI variable. type: REAL, INTEGER, BOOLEAN or STRING; causality: IN, OUT or PAR;
+    variability and initial as FMI 2.0 spells them (initial None: not stated); unit: an
+    FMI unit name of UNITS (Real only)."""
+
+    name: str
+    type: str
+    causality: str
+    variability: str
+    start: float | int | bool | str
+    description: str
+    value_reference: int
+    unit: str | None = None
+    initial: str | None = None
+
+
+class Table(list):
+    """Variables in the order of their value references 0, 1, 2, …; each helper appends
+    its rows and returns them."""
+
+    def add(self, name, type_, causality, variability, start, description, unit=None, initial=None) -> list[Variable]:
+        if unit is not None and unit not in UNITS:
+            raise ValueError(f"unit {unit!r} has no definition in fmu_src.variables.UNITS")
+        self.append(Variable(name, type_, causality, variability, start, description, len(self), unit, initial))
+        return self[-1:]
+
+    def real(self, name, start, unit, description, causality) -> list[Variable]:
+        """A Real input, output or (fixed) parameter; outputs start exact, held until a step sets them."""
+        return self.add(name, REAL, causality, "fixed" if causality == PAR else "continuous", float(start),
+                        description, unit, "exact" if causality == OUT else None)
+
+    def vector(self, prefix, start, unit, description, causality, components="xyz") -> list[Variable]:
+        """prefix_<c> for each component c; description may use {c}."""
+        return [v for c, value in zip(components, start)
+                for v in self.real(f"{prefix}_{c}", value, unit, description.format(c=c), causality)]
+
+    def parameter(self, name, start, description, type_=STRING) -> list[Variable]:
+        """A fixed String, Integer or Boolean parameter."""
+        return self.add(name, type_, PAR, "fixed", start, description)
+
+    def boolean_output(self, name, start, description) -> list[Variable]:
+        return self.add(name, BOOLEAN, OUT, "discrete", bool(start), description, initial="exact")
+
+    def extend_from(self, rows) -> list[Variable]:
+        """Rows of another table, which must continue this one's value references."""
+        rows = list(rows)
+        for k, v in enumerate(rows):
+            if v.value_reference != len(self) + k:
+                raise ValueError(f"{v.name} has value reference {v.value_reference}, not {len(self) + k}")
+        self.extend(rows)
+        return rows
+
+
+def tuning_parameters() -> dict:
+    """Every method's tuning parameters and those of the gyro-offset and heading
+    estimators, once each: name → (FMI unit, description, start value). The start value is
+    the default where every stage with the name has that one default, else NaN: unset."""
+    found = {}
+    for owner, stage in (*((f"method {m.name}", m.params) for m in METHODS.values()), *ESTIMATORS.items()):
+        for p in stage:
+            found.setdefault(p.name, []).append((owner, p))
+    params = {}
+    for name, uses in found.items():
+        first = uses[0][1]
+        defaults = {p.default for _, p in uses}
+        if len(defaults) == 1 and first.default is not None:
+            params[name] = (fmi_unit(first.unit), f"{first.doc}; default {first.default:g}", first.default)
+            continue
+        if defaults == {None}:
+            doc = f"{first.doc}; NaN (the start value): unset"
+        else:
+            each = "; ".join(f"{owner}: {'unset' if p.default is None else format(p.default, 'g')}" for owner, p in uses)
+            doc = f"{first.doc}; NaN (the start value): the default of the stage that runs ({each})"
+        params[name] = (fmi_unit(first.unit), doc, math.nan)
+    return params
+
+
+@cache
+def attitude_estimator() -> tuple[Variable, ...]:
+    """AttitudeEstimator's interface (fmu_src/AttitudeEstimator.py says what each step does)."""
+    t = Table()
+    t.vector("gyr", (0.0, 0.0, 0.0), "rad/s", "gyro {c}, mean rate over the step (gyr_samples mean) "
+             "or the rate at its end (point)", IN)
+    t.vector("acc", (0.0, 0.0, 9.81), "m/s2", "specific force {c} at the end of the step (acc_samples point) "
+             "or its mean over the step (mean)", IN)
+    t.vector("mag", (0.0, 0.0, 0.0), "uT", "magnetic field {c}; all 0: no magnetometer (heading from the gyro); "
+             "NaN: no sample this step", IN)
+    t.vector("q", (1.0, 0.0, 0.0, 0.0), "1", "orientation quaternion {c}, sensor -> earth (ENU)", OUT, "wxyz")
+    t.vector("g", (0.0, 0.0, 1.0), "1", "estimated unit up-vector {c}, sensor coordinates", OUT)
+    for name in ("roll", "pitch", "yaw"):
+        t.real(name, 0.0, "rad", f"{name} (Z-Y-X Euler angles of q; derived output)", OUT)
+    t.vector("gyr_offset", (0.0, 0.0, 0.0), "rad/s", "estimated gyro offset {c} (gyro_offset on; else 0)", OUT)
+    t.vector("mag_offset", (0.0, 0.0, 0.0), "uT", "estimated hard-iron offset {c} of the magnetometer "
+             "(heading mag; 0 until one is proven)", OUT)
+    t.real("mag_delay_used", 0.0, "s", "the magnetometer's delay behind the gyro the heading allows for "
+           "(the parameter mag_delay, or its online estimate: 0 until one is taken)", OUT)
+    t.boolean_output("valid", False, "an estimate is available and the last inputs were finite")
+    t.parameter("method", "wiener", f"estimator: {', '.join(METHODS)}")
+    t.parameter("heading", "mag", "heading source: mag (magnetometer, hard iron fitted, guarded against "
+                "disturbances) or gyro")
+    t.parameter("gyro_offset", "on", "on (default, as attitude estimate): estimate and remove the gyro offset "
+                "(at rest and while moving); off: for a gyro without offset")
+    t.real("Ts", 0.01, "s", "sample time the estimator expects (other step sizes are re-discretised)", PAR)
+    t.parameter("gyr_samples", "mean", "mean: gyr is the mean rate over the step (the FMI convention of "
+                "MotionProfile and ImuSensor); point: the rate at the step's end (most models' outputs), "
+                "averaged with the last one")
+    t.parameter("acc_samples", "point", "point: acc is the specific force at the step's end (the FMI "
+                "convention of MotionProfile and ImuSensor); mean: its mean over the step (a sensor that "
+                "averages it as the gyro), turned to the step's end by half the step's rotation")
+    t.real("latency", 0.0, "s", "the IMU's delay behind the motion (its filters' group delay, gyr taken as the "
+           "mean rate over the step); q and g are carried forward over it with the gyro", PAR)
+    for name, (unit, doc, start) in tuning_parameters().items():
+        t.real(name, start, unit, doc, PAR)
+    return tuple(t)
