@@ -15,7 +15,6 @@ gyros have no offset, and the bounds are the filters' own.
 from __future__ import annotations
 
 import math
-import sys
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -27,6 +26,7 @@ from attitude_fmu.blocks.filters import accuracy
 from attitude_fmu.blocks.filters.earth_filters import settle_time
 from attitude_fmu.blocks.methods.registry import METHODS
 from attitude_fmu.blocks.methods.registry import method as get_method
+from attitude_fmu.systems.cluster.jobs import Failure, Jobs
 from attitude_fmu.systems.fmi.cosim import cosimulate
 from attitude_fmu.systems.fmi.ssp import write_ssp
 from attitude_fmu.systems.simulation.motion import PROFILES
@@ -82,7 +82,7 @@ SCENARIOS = {
 }
 
 
-def verify_one(fmu_dir, profile: str, method: str, workdir, step: float = STEP_S, progress=None) -> dict:
+def verify_one(fmu_dir, profile: str, method: str, workdir, step: float = STEP_S) -> dict:
     """Co-simulate one profile with one method; the row of the verify table."""
     scenario = SCENARIOS[profile]
     m = get_method(method)
@@ -98,7 +98,7 @@ def verify_one(fmu_dir, profile: str, method: str, workdir, step: float = STEP_S
         "imu": dict(scenario.imu),
         "estimator": {"method": method, "Ts": step, "gyro_offset": "off"},
     }, scenario.duration, step)
-    out = cosimulate(ssp, scenario.duration, step, progress=progress)
+    out = cosimulate(ssp, scenario.duration, step)
     q_true = np.column_stack([out[f"motion.qt_{c}"] for c in "wxyz"])[start:]
     up_true = np.column_stack([2 * (q_true[:, 1] * q_true[:, 3] - q_true[:, 0] * q_true[:, 2]),
                                2 * (q_true[:, 2] * q_true[:, 3] + q_true[:, 0] * q_true[:, 1]),
@@ -117,20 +117,19 @@ def verify_one(fmu_dir, profile: str, method: str, workdir, step: float = STEP_S
     return row
 
 
-def verify(fmu_dir, profiles=None, methods=None, step: float = STEP_S, progress: bool = True) -> list[dict]:
-    """Rows for every profile × method (default: all)."""
-    profiles = list(profiles or SCENARIOS)
-    methods = list(methods or METHODS)
-    rows = []
+def verify_job(fmu_dir, profile: str, method: str, step: float = STEP_S) -> dict:
+    """verify_one in a folder of its own; a job of verify."""
     with tempfile.TemporaryDirectory(prefix="attitude_verify_") as workdir:
-        for i, (profile, method) in enumerate((p, m) for p in profiles for m in methods):
-            label = f"verify: {i + 1}/{len(profiles) * len(methods)} {profile} × {method}"
-            tty = sys.stderr.isatty()
-            report = (lambda f, label=label: print(f"\r{label} {f:4.0%}", end="", file=sys.stderr, flush=True)) \
-                if progress and tty else None
-            if progress and not tty:
-                print(f"{label} …", file=sys.stderr, flush=True)
-            rows.append(verify_one(fmu_dir, profile, method, workdir, step, report))
-            if progress:
-                print(f"\r{label} done", file=sys.stderr, flush=True)
-    return rows
+        return verify_one(fmu_dir, profile, method, workdir, step)
+
+
+def verify(fmu_dir, profiles=None, methods=None, step: float = STEP_S, progress: bool = True,
+           jobs: Jobs | None = None) -> list[dict]:
+    """Rows for every profile × method (default: all); each row is a job of jobs
+    (systems.cluster.jobs.Jobs; default: this process, a bar when progress), whose workers
+    see fmu_dir at its absolute path. A row whose job failed (jobs reports it) is left out."""
+    runs = [(p, m) for p in list(profiles or SCENARIOS) for m in list(methods or METHODS)]
+    jobs = jobs or Jobs(bar=progress)
+    rows = jobs.map(verify_job, [(str(Path(fmu_dir).absolute()), p, m, step) for p, m in runs],
+                    [f"{p} × {m}" for p, m in runs], "co-simulations")
+    return [row for row in rows if not isinstance(row, Failure)]
