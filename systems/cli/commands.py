@@ -287,6 +287,12 @@ def build_parser() -> argparse.ArgumentParser:
     bn.add_argument("--fmu", action="store_true",
                     help="per-step cost of AttitudeEstimator.fmu against a no-op FMU of the same interface")
     bn.add_argument("--repeat", type=int, default=10, help="interleaved rounds; each method's best run counts (default 10)")
+    bn.add_argument("--workers", type=_workers, metavar="N",
+                    help="instead: wall time of attitude evaluate on --recordings and of attitude table1 on a local "
+                         "cluster of N worker processes against one process, start-up included, and their ratio")
+    bn.add_argument("--recordings", nargs="+", default=[], metavar="FILE", help="with --workers: evaluate's files")
+    bn.add_argument("--duration", type=float, default=20000.0,
+                    help="with --workers: table1's simulated seconds per cell (default 20000)")
     return parser
 
 
@@ -584,6 +590,20 @@ def cmd_bench(args) -> int:
 
     if args.samples < 1000 or args.repeat < 1:
         raise ValueError("--samples must be ≥ 1000 and --repeat ≥ 1")
+    if args.workers:
+        from attitude_fmu.systems.evaluation.bench import bench_workers
+
+        result = bench_workers(args.recordings, args.workers, args.duration)
+        if args.json:
+            print(json.dumps(result, indent=2))
+        else:
+            for name in ("evaluate", "table1"):
+                if name in result:
+                    r = result[name]
+                    print(f"{name:>8}, {r['jobs']} jobs: 1 process {r['serial_s']:.1f} s, {args.workers} workers "
+                          f"{r['distributed_s']:.1f} s, ratio {r['ratio']:.2f}; results "
+                          f"{'identical' if r['identical'] else 'DIFFER'}")
+        return 0
     if args.fmu:
         from attitude_fmu.systems.evaluation.bench import bench_fmu
 

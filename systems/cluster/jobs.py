@@ -18,7 +18,7 @@ import uuid
 from dataclasses import dataclass
 
 JOB_ERRORS = (ValueError, OSError, RuntimeError)  # a job's own failure, as the CLI reports them
-CONNECT_TIMEOUT_S = 30.0  # for --scheduler ADDRESS
+CONNECT_TIMEOUT_S = 10.0  # for --scheduler ADDRESS
 WORKER_PLUGIN = "attitude-fmu-worker-exit"
 
 
@@ -76,11 +76,6 @@ class Jobs:
             self._cluster.close()
             self._cluster = None
 
-    @property
-    def distributed(self) -> bool:
-        """Whether jobs go to worker processes (a scheduler given, or more than one worker)."""
-        return self.scheduler is not None or self.workers > 1
-
     def map(self, function, jobs, names, what: str = "jobs") -> list:
         """[function(*job) for job in jobs] in the jobs' order, a Failure for a job that failed;
         failures are reported on standard error in that order once every job has ended
@@ -92,7 +87,7 @@ class Jobs:
 
         with tqdm(total=len(jobs), desc=what, unit="job", file=sys.stderr, leave=False,
                   disable=not (self.bar and jobs and sys.stderr.isatty())) as bar:
-            if self.distributed and (len(jobs) > 1 or self.scheduler is not None):
+            if self.scheduler is not None or (self.workers > 1 and len(jobs) > 1):
                 outcomes = self._on_cluster(function, jobs, what, bar)
             else:
                 outcomes = []
@@ -116,8 +111,8 @@ class Jobs:
             try:
                 outcomes[index[future.key]] = future.result()
             except KilledWorker as exc:
-                outcomes[index[future.key]] = ("error", f"every worker that ran it died ({exc}); a job that ends its "
-                                                        "process (out of memory, a crash) is not retried further")
+                outcomes[index[future.key]] = ("error", (f"every worker that ran it died ({exc}); a job that ends "
+                                                         "its process (out of memory, a crash) is not retried further"))
             future.release()
             bar.update()
         return outcomes
@@ -130,7 +125,7 @@ class Jobs:
         import dask
         from distributed import Client, LocalCluster
 
-        from attitude_fmu.systems.cluster.worker_exit import FmuWorkerExit
+        from attitude_fmu.systems.cluster.worker_exit import WorkerExit
 
         if self.scheduler is None:
             # glibc's own trim threshold, not Dask's 64 KiB: the jobs' many large temporaries
@@ -139,7 +134,8 @@ class Jobs:
                        if name != "MALLOC_TRIM_THRESHOLD_"}
             with dask.config.set({"distributed.nanny.pre-spawn-environ": environ}):
                 self._cluster = LocalCluster(n_workers=min(self.workers, jobs), threads_per_worker=1,
-                                             processes=True, dashboard_address=None)
+                                             processes=True, dashboard_address="127.0.0.1:0",  # any free port
+                                             scheduler_kwargs={"dashboard": False})
             self.client = Client(self._cluster)
         else:
             try:
@@ -147,7 +143,7 @@ class Jobs:
             except (OSError, TimeoutError) as exc:
                 raise RuntimeError(f"cannot reach the Dask scheduler at {self.scheduler}: {exc}") from None
             self._check_workers()
-        self.client.register_plugin(FmuWorkerExit(), name=WORKER_PLUGIN)
+        self.client.register_plugin(WorkerExit(always=self._cluster is not None), name=WORKER_PLUGIN)
         return self.client
 
     def _check_workers(self) -> None:

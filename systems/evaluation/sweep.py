@@ -100,8 +100,8 @@ def sweep(paths, grid, setup: Setup | None = None, score_on=(), by: str = "incli
     jobs = jobs or Jobs(bar=progress)
     label = method_label(setup.method, setup.offline)
     combos, names = combinations(grid), recording_names(paths)
-    flat = _runs(jobs, [(path, _with(setup, combo), f"{path} with {_text(combo)}") for combo in combos for path in paths],
-                 "runs")
+    flat = _runs(jobs, [(path, _with(setup, combo), f"{path} with {_text(combo)}")
+                        for combo in combos for path in paths], "runs")
     table = [flat[i * len(paths):(i + 1) * len(paths)] for i in range(len(combos))]  # [combination][recording]
     if progress:
         print_notes(note for run in table[0] if not isinstance(run, Failure) for note in run["notes"])
@@ -141,8 +141,8 @@ def format_table(result: dict, method: str) -> str:
     names = [g["name"] for g in result["grid"]]
     recordings = {name for r in result["results"] for name in r["recordings"]}
     best = result["best"]
-    lines = [f"{method} over {len(result['results'])} combinations on {len(recordings)} recordings: RMSE over the "
-             "movement phase, degrees, inclination / heading / total; mean over the recordings"]
+    lines = [(f"{method} over {len(result['results'])} combinations on {len(recordings)} recordings: RMSE over the "
+              "movement phase, degrees, inclination / heading / total; mean over the recordings")]
     width = max(10, *(len(n) + 1 for n in names))
     lines.append("  " + "".join(f"{n:>{width}}" for n in names) + f" {'mean':>24}")
 
