@@ -60,7 +60,7 @@ def _check(paths, grid, setup: Setup, score_on) -> None:
         raise ValueError("a sweep needs at least one --grid NAME=V1,V2,...")
     twice = sorted({name for name in names if names.count(name) > 1} | set(names) & set(setup.params or {}))
     if twice:
-        raise ValueError(f"{', '.join(twice)} given more than once (in --grid and --param)")
+        raise ValueError(f"{', '.join(twice)} given more than once: a parameter takes one --grid or one --param")
     for combination in combinations(grid):
         _with(setup, combination).check()
     both = sorted({str(Path(p).resolve()) for p in paths} & {str(Path(p).resolve()) for p in score_on})
