@@ -125,7 +125,7 @@ class Setup:
 
 def read_prepared(path, setup: Setup) -> Recording:
     """The recording at path as setup evaluates it: read, its samples turned to the
-    project's convention, cut into its movement, its reference checked."""
+    project's convention, cut into its movement."""
     rec = read_recording(path, **(setup.read_options or {}))
     if setup.gyr_samples == "point":
         rec = replace(rec, gyr=interval_means(rec.gyr))
@@ -133,7 +133,6 @@ def read_prepared(path, setup: Setup) -> Recording:
         rec = replace(rec, acc=interval_ends(rec.gyr, rec.acc, 1.0 / rec.fs))
     if setup.start_in_movement is not None:
         rec = rec.into_movement(setup.start_in_movement)
-    rec.evaluated()
     return rec
 
 
