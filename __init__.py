@@ -15,8 +15,9 @@ What a script needs, by task (each name's own docstring has its units and defaul
   `quaternion_errors`, `inclination_error`;
 - FMUs: `build_fmus`, `FmuRunner` (one FMU stepped from Python), `write_ssp`, `cosimulate`,
   `verify`;
-- scores: `evaluate` (recordings with a reference), `compare` (simulated profiles, peers),
-  `table1` (Rizun's Table 1).
+- scores: `evaluate` (recordings with a reference), `sweep` (a parameter grid on them),
+  `compare` (simulated profiles, peers), `table1` (Rizun's Table 1); each takes `jobs=`, a
+  `Jobs` that runs its jobs in this process or on a Dask cluster (docs/distributed.md).
 
 Names load their module on first use, so `import attitude_fmu` stays light (an FMU
 carries only the modules it imports).
@@ -64,6 +65,8 @@ _API = {
     "evaluate": "systems.evaluation.evaluate",
     "compare": "systems.evaluation.compare",
     "table1": "systems.evaluation.experiments",
+    "sweep": "systems.evaluation.sweep",
+    "Jobs": "systems.cluster.jobs",
 }
 __all__ = list(_API)
 
@@ -99,9 +102,11 @@ if TYPE_CHECKING:  # the same names for type checkers and editors
     from .blocks.stages.gyro_offset import offset_system
     from .blocks.stages.heading import heading_system
     from .blocks.stages.timing import latency_system
+    from .systems.cluster.jobs import Jobs
     from .systems.evaluation.compare import compare
     from .systems.evaluation.evaluate import evaluate
     from .systems.evaluation.experiments import table1
+    from .systems.evaluation.sweep import sweep
     from .systems.fmi.build import build_fmus
     from .systems.fmi.cosim import FmuRunner, cosimulate
     from .systems.fmi.ssp import write_ssp

@@ -1,4 +1,4 @@
-"""The `attitude` command line: estimate, evaluate, plot, table1, verify, ssp, compare, bode, bench."""
+"""The `attitude` command line: estimate, evaluate, sweep, plot, table1, verify, ssp, compare, bode, bench."""
 from __future__ import annotations
 
 import argparse
@@ -40,6 +40,15 @@ def _param(text: str) -> tuple[str, float]:
     except ValueError:
         raise argparse.ArgumentTypeError(f"{name}: {value!r} is not a number") from None
     return name.strip(), number
+
+
+def _grid(text: str) -> tuple[str, tuple[float, ...]]:
+    from attitude_fmu.systems.evaluation.sweep import parse_grid
+
+    try:
+        return parse_grid(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
 
 
 def _column(text: str) -> tuple[str, str]:
@@ -121,6 +130,31 @@ def _add_input_flags(parser) -> None:
                              "measures it against the reference)")
 
 
+def _workers(text: str) -> int:
+    if not text.isdigit() or int(text) < 1:
+        raise argparse.ArgumentTypeError(f"expected a whole number ≥ 1, got {text!r}")
+    return int(text)
+
+
+def _add_cluster_flags(parser, jobs: str) -> None:
+    parser.add_argument("--workers", type=_workers, metavar="N",
+                        help=f"run the {jobs} on a local Dask cluster of N worker processes (default: the number "
+                             "of cores); 1 runs them in this process. Results are those of the serial run, in order")
+    parser.add_argument("--scheduler", metavar="ADDRESS",
+                        help=f"run the {jobs} on the Dask cluster whose scheduler is at ADDRESS (e.g. "
+                             "tcp://host:8786); its workers need this package and the files at the paths given "
+                             "(docs/distributed.md)")
+
+
+def _jobs(args):
+    """The Jobs of --workers and --scheduler; a progress bar unless --json."""
+    from attitude_fmu.systems.cluster.jobs import Jobs, default_workers
+
+    if args.scheduler is not None and args.workers is not None:
+        raise ValueError("give --workers or --scheduler, not both: a cluster's workers are its own")
+    return Jobs(args.workers or default_workers(), args.scheduler, bar=not getattr(args, "json", False))
+
+
 def _timing(args) -> dict:
     """The sample-timing flags as keyword arguments of estimate, evaluate, plot and check_options."""
     return {"latency": args.latency, "gyr_samples": args.gyr_samples, "acc_samples": args.acc_samples}
@@ -185,6 +219,30 @@ def build_parser() -> argparse.ArgumentParser:
                          "a first sample in motion (a test of start-up and offset tracking)")
     _add_input_flags(ev)
     _add_real_data_flags(ev)
+    _add_cluster_flags(ev, "recordings")
+
+    sw = sub.add_parser("sweep", help="every combination of a parameter grid on every recording with a reference: "
+                                      "errors per recording and on average, and the best combination")
+    sw.add_argument("files", nargs="+", metavar="FILE")
+    sw.add_argument("--method", default="wiener", choices=sorted(METHODS))
+    sw.add_argument("--grid", type=_grid, action="append", default=[], metavar="NAME=V1,V2,...", required=True,
+                    help="values of a parameter of the method, the gyro-offset or the heading estimator, in its "
+                         "unit (attitude estimate -h lists them); repeatable: every combination is run")
+    sw.add_argument("--param", type=_param, action="append", default=[], metavar="NAME=VALUE",
+                    help="a parameter held at VALUE in every combination; repeatable")
+    sw.add_argument("--score-on", nargs="+", default=[], metavar="FILE",
+                    help="other recordings on which the best combination is scored (a combination chosen on the "
+                         "recordings it is scored on is tuned to them)")
+    sw.add_argument("--by", default="inclination", choices=["inclination", "heading", "total"],
+                    help="the mean RMSE the best combination has the lowest of (default inclination)")
+    out = sw.add_mutually_exclusive_group()
+    out.add_argument("--json", action="store_true", help="print JSON instead of the table")
+    out.add_argument("--csv", metavar="OUT", help="also write every combination's errors per recording to OUT")
+    sw.add_argument("--start-in-movement", type=float, metavar="S",
+                    help="begin each recording S seconds into its movement phase")
+    _add_input_flags(sw)
+    _add_real_data_flags(sw)
+    _add_cluster_flags(sw, "combinations × recordings")
 
     pl = sub.add_parser("plot", help="a recording's error over time and its spectrum against eq. 42 (PNG); "
                         "without a reference, the estimate's angles over time")
@@ -203,10 +261,12 @@ def build_parser() -> argparse.ArgumentParser:
     t1.add_argument("--duration", type=float, default=20000.0, help="simulated seconds per cell (default 20000)")
     t1.add_argument("--fs", type=float, default=100.0, help="simulation sample rate, Hz (default 100)")
     t1.add_argument("--seed", type=int, default=0)
+    _add_cluster_flags(t1, "cells")
 
     vf = sub.add_parser("verify", help="co-simulate every profile with every estimator as FMUs; exit 1 if a bound is missed")
     vf.add_argument("--json", action="store_true")
     _add_verify_flags(vf)
+    _add_cluster_flags(vf, "co-simulations (profile × method)")
     vf.add_argument("--python", action="store_true", help="also run the pythonfmu chain and hold its estimator "
                     "outputs to the native chain's within 1e-9 (minutes instead of seconds)")
     ss = sub.add_parser("ssp", help="write verify's SSP of each profile × method, the FMUs inside, for other tools")
@@ -229,6 +289,7 @@ def build_parser() -> argparse.ArgumentParser:
                          "drawn once (1 = 100 %%; default 0, an ideal scale)")
     cp.add_argument("--offline", action="store_true",
                     help="also the smoothers: every earth-frame method offline, and vqf's offline estimate")
+    _add_cluster_flags(cp, "profiles")
 
     bd = sub.add_parser("bode", help="frequency response of a method's filter (tseng: also Tseng Figs. 6-7)")
     bd.add_argument("--method", default="tseng", choices=sorted(m for m in METHODS if METHODS[m].is_sensor_frame))
@@ -241,6 +302,12 @@ def build_parser() -> argparse.ArgumentParser:
                     help="per-step cost of AttitudeEstimator.fmu against a no-op FMU of the same interface, pythonfmu "
                          "and native, under fmpy; and of the native against the pythonfmu one in a C host")
     bn.add_argument("--repeat", type=int, default=10, help="interleaved rounds; each method's best run counts (default 10)")
+    bn.add_argument("--workers", type=_workers, metavar="N",
+                    help="instead: wall time of attitude evaluate on --recordings and of attitude table1 on a local "
+                         "cluster of N worker processes against one process, start-up included, and their ratio")
+    bn.add_argument("--recordings", nargs="+", default=[], metavar="FILE", help="with --workers: evaluate's files")
+    bn.add_argument("--duration", type=float, default=20000.0,
+                    help="with --workers: table1's simulated seconds per cell (default 20000)")
     return parser
 
 
@@ -379,12 +446,16 @@ def cmd_evaluate(args) -> int:
     except ImportError as exc:
         raise RuntimeError(f"attitude evaluate compares with vqf and ahrs ({exc}); "
                            "install them with: pip install 'attitude-fmu[peers]'") from None
-    result = evaluate(args.files, args.method, dict(args.param), args.offline, args.gyro_offset == "on",
-                      args.heading == "mag", start_in_movement=args.start_in_movement,
-                      read_options=_read_options(args), **_timing(args))
+    with _jobs(args) as jobs:
+        result = evaluate(args.files, args.method, dict(args.param), args.offline, args.gyro_offset == "on",
+                          args.heading == "mag", start_in_movement=args.start_in_movement,
+                          read_options=_read_options(args), **_timing(args), jobs=jobs)
+    status = EXIT_BAD_INPUT if "failed" in result else 0
     if args.json:
         print(json.dumps(result, indent=2))
-        return 0
+        return status
+    if not result["recordings"]:
+        return status
     labels = list(result["mean"])
     print("RMSE over the movement phase, degrees: inclination / heading / total; IMU lag behind the reference, ms")
     print(f"{'recording':>45} " + " ".join(f"{label:>22}" for label in labels) + f" {'lag':>6}")
@@ -394,7 +465,27 @@ def cmd_evaluate(args) -> int:
         lag = result["imu_latency_s"].get(name)
         print(f"{name:>45} {cells} {'' if name == 'mean' else '     —' if lag is None else format(1e3 * lag, '6.2f')}"
               .rstrip())
-    return 0
+    return status
+
+
+def cmd_sweep(args) -> int:
+    from attitude_fmu.systems.evaluation.evaluate import Setup
+    from attitude_fmu.systems.evaluation.sweep import report, sweep, write_csv
+
+    for source in (args.files + args.score_on) if args.csv else ():
+        _check_out(args.csv, source)
+    setup = Setup(args.method, dict(args.param), args.offline, args.gyro_offset == "on", args.heading == "mag",
+                  args.start_in_movement, _read_options(args), **_timing(args))
+    with _jobs(args) as jobs:
+        result = sweep(args.files, args.grid, setup, args.score_on, args.by, jobs=jobs)
+    if args.json:
+        print(json.dumps(result, indent=2))
+    else:
+        report(result, args.method, args.score_on)
+    if args.csv:
+        write_csv(result, args.csv)
+        print(f"attitude: wrote {args.csv}", file=sys.stderr)
+    return EXIT_BAD_INPUT if "failed" in result or result["best"] is None else 0
 
 
 def cmd_plot(args) -> int:
@@ -418,10 +509,11 @@ def cmd_table1(args) -> int:
 
     if not (args.duration > 0 and args.fs > 0):
         raise ValueError("--duration and --fs must be positive")
-    rows = table1(duration=args.duration, fs=args.fs, seed=args.seed)
+    with _jobs(args) as jobs:
+        rows = table1(duration=args.duration, fs=args.fs, seed=args.seed, jobs=jobs)
     failed = [
         (row, cell) for row in rows for cell in row["cells"]
-        if abs(cell["simulated_deg"] / cell["analytic_deg"] - 1) > TABLE1_TOLERANCE
+        if cell["simulated_deg"] is not None and abs(cell["simulated_deg"] / cell["analytic_deg"] - 1) > TABLE1_TOLERANCE
     ]
     if args.json:
         print(json.dumps(rows, indent=2))
@@ -431,8 +523,12 @@ def cmd_table1(args) -> int:
         print(f"{'δn °/s/√Hz':>11} {'δv m/s/√Hz':>11} {'1/ω_g s':>8}  "
               + "  ".join(f"{'a=' + format(c['a'], 'g'):>16}" for c in rows[0]["cells"]))
         for row in rows:
-            cells = "  ".join(f"{c['analytic_deg']:7.3f} | {c['simulated_deg']:6.3f}" for c in row["cells"])
+            cells = "  ".join(f"{c['analytic_deg']:7.3f} | "
+                              + ("failed" if c["simulated_deg"] is None else f"{c['simulated_deg']:6.3f}")
+                              for c in row["cells"])
             print(f"{row['delta_n_deg']:11.2f} {row['delta_v']:11.1f} {row['inv_omega_g_s']:8.2f}  {cells}")
+    if jobs.failed:
+        return EXIT_BAD_INPUT
     if failed:
         print(f"attitude: {len(failed)} simulated cells off eq. 50 by more than ±{TABLE1_TOLERANCE:.0%}",
               file=sys.stderr)
@@ -465,7 +561,9 @@ def cmd_verify(args) -> int:
     from attitude_fmu.systems.fmi.verify import verify
     from attitude_fmu.systems.simulation.motion import PROFILES
 
-    rows = verify(_verified_fmus(args), args.profile, args.method, python=args.python)
+    fmu_dir = _verified_fmus(args)
+    with _jobs(args) as jobs:
+        rows = verify(fmu_dir, args.profile, args.method, python=args.python, jobs=jobs)
     if args.json:
         print(json.dumps({"rows": rows}, indent=2))
     else:
@@ -482,6 +580,8 @@ def cmd_verify(args) -> int:
         print(f"chain: {rows[0]['chain'] if rows else '—'}; native Δ: the largest difference between the estimator "
               "outputs (Euler angles aside) of the native chain (FMUs in C) and the pythonfmu one, with the same "
               "seeds (— without --python)")
+    if jobs.failed:
+        return EXIT_BAD_INPUT
     failed = [r for r in rows if not r["pass"]]
     if failed:
         print(f"attitude: {len(failed)} of {len(rows)} rows missed their bound", file=sys.stderr)
@@ -496,17 +596,19 @@ def cmd_compare(args) -> int:
     for name in args.profile or []:
         known_profile(name)  # refuses unknown names
     imu = imu_model(args.gyro_noise, args.acc_noise, args.gyro_scale_error)
-    result = compare(args.profile, imu=imu, offline=args.offline)
+    with _jobs(args) as jobs:
+        result = compare(args.profile, imu=imu, offline=args.offline, jobs=jobs)
+    status = EXIT_BAD_INPUT if jobs.failed else 0
     if args.json:
         print(json.dumps(result, indent=2))
-        return 0
+        return status
     print(f"inclination error, degrees: RMS / max / mean (bias); default parameters; gyro {args.gyro_noise:g} °/s/√Hz, "
           f"scale error {args.gyro_scale_error:g}, accelerometer {args.acc_noise:g} m/s²/√Hz")
     for profile, rows in result["profiles"].items():
         print(f"\n{profile}")
         for method, r in rows.items():
             print(f"  {method:>19} {r['rms_deg']:8.3f} {r['max_deg']:8.3f} {r['mean_deg']:9.4f}")
-    return 0
+    return status
 
 
 def cmd_bode(args) -> int:
@@ -524,6 +626,20 @@ def cmd_bench(args) -> int:
 
     if args.samples < 1000 or args.repeat < 1:
         raise ValueError("--samples must be ≥ 1000 and --repeat ≥ 1")
+    if args.workers:
+        from attitude_fmu.systems.evaluation.bench import bench_workers
+
+        result = bench_workers(args.recordings, args.workers, args.duration)
+        if args.json:
+            print(json.dumps(result, indent=2))
+        else:
+            for name in ("evaluate", "table1"):
+                if name in result:
+                    r = result[name]
+                    print(f"{name:>8}, {r['jobs']} jobs: 1 process {r['serial_s']:.1f} s, {args.workers} workers "
+                          f"{r['distributed_s']:.1f} s, ratio {r['ratio']:.2f}; results "
+                          f"{'identical' if r['identical'] else 'DIFFER'}")
+        return 0
     if args.fmu:
         from attitude_fmu.systems.evaluation.bench import bench_fmu
 
@@ -554,7 +670,8 @@ def cmd_bench(args) -> int:
 
 def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
-    handler = {"estimate": cmd_estimate, "evaluate": cmd_evaluate, "plot": cmd_plot, "table1": cmd_table1, "verify": cmd_verify, "ssp": cmd_ssp, "compare": cmd_compare,
+    handler = {"estimate": cmd_estimate, "evaluate": cmd_evaluate, "sweep": cmd_sweep, "plot": cmd_plot,
+               "table1": cmd_table1, "verify": cmd_verify, "ssp": cmd_ssp, "compare": cmd_compare,
                "bode": cmd_bode, "bench": cmd_bench}[args.command]
     try:
         if hasattr(args, "latency"):

@@ -1,6 +1,9 @@
-"""Throughput of the batch estimator against vqf's C++ core and ahrs' Madgwick, same run."""
+"""Throughput of the batch estimator against vqf's C++ core and ahrs' Madgwick, same run;
+of an FMU step against a no-op FMU; and the wall time of evaluate and table1 on a local
+Dask cluster against the same in this process (bench_workers)."""
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 import tempfile
@@ -177,3 +180,30 @@ def bench_fmu(steps: int = 5000, repeat: int = 5, progress: bool = True) -> dict
             "native_ratio_vs_noop": per_step["native/AttitudeEstimator"] / per_step["native/NoOpEstimator"],
             "c_host_us_per_step": c_host,
             "native_speedup_c_host": c_host["AttitudeEstimator"] / c_host["native/AttitudeEstimator"]}
+
+
+
+def bench_workers(files=(), workers: int = 2, duration: float = 20000.0) -> dict:
+    """Wall time (s) of `attitude evaluate --json FILE...` (when files are given) and of
+    `attitude table1 --json --duration S`, each a fresh process as a user runs it, with
+    --workers 1 (in that process) and --workers N (a local cluster, its start-up included);
+    the ratio of the two, and whether both printed the same results, byte for byte."""
+    commands = {"table1": ["table1", "--duration", repr(duration)]}
+    if files:
+        commands = {"evaluate": ["evaluate", *map(str, files)], **commands}
+    out = {"workers": workers}
+    for name, command in commands.items():
+        seconds, printed = {}, {}
+        for n in (1, workers):
+            start = time.perf_counter()
+            run = subprocess.run([sys.executable, "-m", "attitude_fmu.systems.cli.commands", *command, "--json",
+                                  "--workers", str(n)], capture_output=True, text=True)
+            seconds[n] = time.perf_counter() - start
+            if run.returncode != 0:
+                raise RuntimeError(f"attitude {' '.join(command)} --workers {n} failed: {run.stderr[-2000:]}")
+            printed[n] = run.stdout
+        jobs = len(files) if name == "evaluate" else sum(len(row["cells"]) for row in json.loads(printed[1]))
+        out[name] = {"jobs": jobs,
+                     "serial_s": seconds[1], "distributed_s": seconds[workers],
+                     "ratio": seconds[1] / seconds[workers], "identical": printed[1] == printed[workers]}
+    return out

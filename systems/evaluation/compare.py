@@ -4,7 +4,6 @@ caller's figures, see imu_model)."""
 from __future__ import annotations
 
 import math
-import sys
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -12,6 +11,7 @@ from scipy.spatial.transform import Rotation
 from attitude_fmu.blocks.errors import bias_angle, inclination_error, rms
 from attitude_fmu.blocks.methods.registry import METHODS
 from attitude_fmu.blocks.pipeline.batch import estimate
+from attitude_fmu.systems.cluster.jobs import Failure, Jobs
 from attitude_fmu.systems.simulation.motion import PROFILES
 from attitude_fmu.systems.simulation.sensor_model import ImuModel
 
@@ -81,12 +81,12 @@ def compare_profile(name: str, methods=None, peers=PEERS, seed: int = 0, imu: Im
 
 
 def compare(profiles=None, methods=None, peers=PEERS, progress: bool = True, imu: ImuModel = IMU,
-            offline: bool = False) -> dict:
-    """{"profiles": {profile: {method: {...}}}} over the profiles (default: all)."""
-    result = {}
+            offline: bool = False, jobs: Jobs | None = None) -> dict:
+    """{"profiles": {profile: {method: {...}}}} over the profiles (default: all); each
+    profile is a job of jobs (systems.cluster.jobs.Jobs; default: this process, a bar when
+    progress). A profile whose job failed (jobs reports it) is left out."""
     names = list(profiles or PROFILES)
-    for i, name in enumerate(names):
-        if progress:
-            print(f"compare: {i + 1}/{len(names)} {name}", file=sys.stderr, flush=True)
-        result[name] = compare_profile(name, methods, peers, imu=imu, offline=offline)
-    return {"profiles": result}
+    jobs = jobs or Jobs(bar=progress)
+    tables = jobs.map(compare_profile, [(name, methods, tuple(peers), 0, imu, offline) for name in names], names,
+                      "profiles")
+    return {"profiles": {name: table for name, table in zip(names, tables) if not isinstance(table, Failure)}}

@@ -5,7 +5,8 @@ from __future__ import annotations
 
 import math
 import sys
-from dataclasses import replace
+from dataclasses import dataclass, replace
+from pathlib import Path
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -14,6 +15,7 @@ from attitude_fmu.blocks.errors import quaternion_errors
 from attitude_fmu.blocks.pipeline.batch import check_options, estimate
 from attitude_fmu.blocks.stages.delays import best_shift
 from attitude_fmu.blocks.stages.timing import carry_forward_rows, interval_ends, interval_means
+from attitude_fmu.systems.cluster.jobs import Failure, Jobs
 from attitude_fmu.systems.evaluation.compare import peer_quaternions
 from attitude_fmu.systems.recordings.reading import read_recording
 from attitude_fmu.systems.recordings.recording import Recording, print_notes
@@ -58,16 +60,20 @@ def imu_latency(rec: Recording) -> float | None:
     return None if lag is None else lag / rec.fs
 
 
+def method_label(method: str, offline: bool) -> str:
+    """The method's key in a recording's table."""
+    return f"{method}_offline" if offline else method
+
+
 def evaluate_recording(rec: Recording, method: str = "wiener", params=None, offline: bool = False,
-                       gyro_offset: bool = True, use_mag: bool = True, latency: float = 0.0) -> dict:
+                       gyro_offset: bool = True, use_mag: bool = True, latency: float = 0.0,
+                       peers: bool = True) -> dict:
     """{method label: {metric: value}} for one recording; with a magnetometer (and use_mag)
     the method's heading comes from it, and vqf's 9D estimate is added as "vqf_9d".
     latency (s): every estimate, the peers' too, is carried forward over the IMU's delay
-    (blocks.stages.timing; the peers' with the raw gyro)."""
+    (blocks.stages.timing; the peers' with the raw gyro). peers=False: the method's alone."""
     rec.evaluated()  # refuses a recording without a usable reference before any work
-    import vqf as vqf_module  # peers: the test extra (or [peers])
-
-    label = f"{method}_offline" if offline else method
+    label = method_label(method, offline)
     mag = rec.mag if use_mag else None
     est = estimate(rec.gyr, rec.acc, rec.fs, method, params, offline=offline, gyro_offset=gyro_offset, mag=mag,
                    latency=latency)
@@ -78,6 +84,10 @@ def evaluate_recording(rec: Recording, method: str = "wiener", params=None, offl
         if latency:
             carry_forward_rows(quat, np.zeros_like(gyr), gyr, latency)
         return errors_on_movement(quat, rec)
+
+    if not peers:
+        return {label: errors_on_movement(est.quat, rec)}
+    import vqf as vqf_module  # peers: the test extra (or [peers])
 
     table = {
         label: errors_on_movement(est.quat, rec),
@@ -91,55 +101,109 @@ def evaluate_recording(rec: Recording, method: str = "wiener", params=None, offl
     return table
 
 
+@dataclass(frozen=True)
+class Setup:
+    """How each recording of an evaluation is read, prepared and estimated (the arguments of
+    evaluate, which documents them); a sweep varies params."""
+
+    method: str = "wiener"
+    params: dict | None = None
+    offline: bool = False
+    gyro_offset: bool = True
+    use_mag: bool = True
+    start_in_movement: float | None = None
+    read_options: dict | None = None
+    latency: float = 0.0
+    gyr_samples: str = "mean"
+    acc_samples: str = "point"
+
+    def check(self) -> None:
+        """Refuse the options before any file is read (blocks.pipeline.batch.check_options)."""
+        check_options(self.method, self.params, self.offline, self.gyro_offset, self.use_mag, self.latency,
+                      self.gyr_samples, self.acc_samples)
+
+
+def read_prepared(path, setup: Setup) -> Recording:
+    """The recording at path as setup evaluates it: read, its samples turned to the
+    project's convention, cut into its movement."""
+    rec = read_recording(path, **(setup.read_options or {}))
+    if setup.gyr_samples == "point":
+        rec = replace(rec, gyr=interval_means(rec.gyr))
+    if setup.acc_samples == "mean":
+        rec = replace(rec, acc=interval_ends(rec.gyr, rec.acc, 1.0 / rec.fs))
+    if setup.start_in_movement is not None:
+        rec = rec.into_movement(setup.start_in_movement)
+    return rec
+
+
+def evaluate_file(path, setup: Setup, peers: bool = True) -> dict:
+    """One recording's job: {"table": {label: metrics}, "imu_latency_s": seconds or None,
+    "notes": [how it was read]}; peers=False: the method's errors alone ("table" holds
+    the method's label only, imu_latency_s None), as a sweep needs them."""
+    rec = read_prepared(path, setup)
+    notes = rec.notes + ([f"{rec.name}: no movement flag; errors over every sample with a reference"]
+                         if rec.movement is None else [])
+    table = evaluate_recording(rec, setup.method, setup.params, setup.offline, setup.gyro_offset, setup.use_mag,
+                               setup.latency, peers)
+    return {"table": table, "imu_latency_s": imu_latency(rec) if peers else None, "notes": notes}
+
+
+def recording_names(paths) -> list[str]:
+    """Each file's key in a result: its stem, or its path where stems repeat (files of one
+    name from several folders)."""
+    stems = [Path(path).stem for path in paths]
+    return stems if len(set(stems)) == len(stems) else [str(path) for path in paths]
+
+
+def mean_over(tables) -> dict:
+    """{label: {metric: mean}} over recordings' tables, for the labels every table has
+    (vqf_9d needs every file's magnetometer)."""
+    tables = list(tables)
+    if not tables:
+        return {}
+    labels = set.intersection(*(set(t) for t in tables))
+    return {label: {m: float(np.mean([t[label][m] for t in tables])) for m in METRICS}
+            for label in tables[0] if label in labels}
+
+
 def evaluate(paths, method: str = "wiener", params=None, offline: bool = False, gyro_offset: bool = True,
              use_mag: bool = True, progress: bool = True, start_in_movement: float | None = None,
-             read_options=None, latency: float = 0.0, gyr_samples: str = "mean", acc_samples: str = "point") -> dict:
+             read_options=None, latency: float = 0.0, gyr_samples: str = "mean", acc_samples: str = "point",
+             jobs: Jobs | None = None) -> dict:
     """{"recordings": {name: {label: metrics}}, "mean": {label: metrics}, "imu_latency_s":
     {name: seconds or None}} over the files (imu_latency: the IMU's delay behind the
-    reference, measured, whatever latency (s) the estimates were carried forward by);
+    reference, measured, whatever latency (s) the estimates were carried forward by), and
+    "failed": {name: message} for files that could not be evaluated, when there are any (the
+    others complete; jobs reports them);
     gyr_samples "point": every recording's gyro is turned into interval means first
     (blocks.stages.timing.interval_means), for the peers and the latency measured as well;
     acc_samples "mean": every accelerometer mean is turned into the sensor frame at its
     sample's time first (blocks.stages.timing.interval_ends), for the peers as well;
     start_in_movement (s): cut each recording to begin that long into its movement phase;
-    read_options: keyword arguments of read_recording (units, fs, max_gap). Every file is
-    read and checked first. A recording's name is its file's stem, or its path where
-    stems repeat. progress also prints how each file was read where it matters (time
-    stamps, no movement flag)."""
-    check_options(method, params, offline, gyro_offset, use_mag, latency, gyr_samples, acc_samples)
-    read = []  # every file read and checked before any estimate: a bad last file costs nothing
-    for path in paths:
-        rec = read_recording(path, **(read_options or {}))
-        if gyr_samples == "point":
-            rec = replace(rec, gyr=interval_means(rec.gyr))
-        if acc_samples == "mean":
-            rec = replace(rec, acc=interval_ends(rec.gyr, rec.acc, 1.0 / rec.fs))
-        if start_in_movement is not None:
-            rec = rec.into_movement(start_in_movement)
-        rec.evaluated()
-        if progress:
-            print_notes(rec.notes + ([f"{rec.name}: no movement flag; errors over every sample with a reference"]
-                                     if rec.movement is None else []))
-        read.append((path, rec))
-    names = [rec.name for _, rec in read]
-    if len(set(names)) < len(names):  # files of one name from several folders: keyed by path
-        names = [str(path) for path, _ in read]
-    recordings, lags = {}, {}
-    for i, (name, (path, rec)) in enumerate(zip(names, read)):
-        if progress:
-            done = int(20 * i / len(paths))
-            print(f"\revaluate [{'#' * done}{'.' * (20 - done)}] {i + 1}/{len(paths)} {path}",
-                  end="" if sys.stderr.isatty() else "\n", file=sys.stderr, flush=True)
-        recordings[name] = evaluate_recording(rec, method, params, offline, gyro_offset, use_mag, latency)
-        lags[name] = imu_latency(rec)
-    if progress and sys.stderr.isatty():
-        print(file=sys.stderr)
+    read_options: keyword arguments of read_recording (units, fs, max_gap). A recording's
+    name is recording_names'. Each file is a job of jobs (systems.cluster.jobs.Jobs; default:
+    this process, a bar when progress); results are those of the serial run, in the files'
+    order. progress also prints how each file was read where it matters (time stamps, no
+    movement flag)."""
+    setup = Setup(method, params, offline, gyro_offset, use_mag, start_in_movement, read_options, latency,
+                  gyr_samples, acc_samples)
+    setup.check()
+    jobs = jobs or Jobs(bar=progress)
+    names = recording_names(paths)
+    results = jobs.map(evaluate_file, [(str(Path(path).absolute()), setup) for path in paths], list(map(str, paths)),
+                       "recordings")
+    done = {name: result for name, result in zip(names, results) if not isinstance(result, Failure)}
+    if progress:
+        print_notes(note for result in done.values() for note in result["notes"])
+    lags = {name: result["imu_latency_s"] for name, result in done.items()}
     found = [lag for lag in lags.values() if lag is not None]
     if progress and found:
         print(f"attitude: note: the IMU lags the reference by {1e3 * min(found):.2f} to {1e3 * max(found):.2f} ms "
               f"(gyro against the reference's rate); --latency S carries every estimate forward by S seconds "
               f"(now {latency:g})", file=sys.stderr)
-    labels = set.intersection(*(set(r) for r in recordings.values()))  # vqf_9d needs every file's mag
-    mean = {label: {m: float(np.mean([r[label][m] for r in recordings.values()])) for m in METRICS}
-            for label in next(iter(recordings.values())) if label in labels}
-    return {"recordings": recordings, "mean": mean, "imu_latency_s": lags}
+    recordings = {name: result["table"] for name, result in done.items()}
+    out = {"recordings": recordings, "mean": mean_over(recordings.values()), "imu_latency_s": lags}
+    failed = {name: result.message for name, result in zip(names, results) if isinstance(result, Failure)}
+    if failed:
+        out["failed"] = failed
+    return out

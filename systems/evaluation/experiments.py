@@ -3,7 +3,6 @@ first-order comparison (§4.2), centripetal bias (§2.4) and angle filtering (§
 from __future__ import annotations
 
 import math
-import sys
 from dataclasses import dataclass
 
 import numpy as np
@@ -16,6 +15,7 @@ from attitude_fmu.blocks.filters.earth_filters import settle_time
 from attitude_fmu.blocks.filters.sensor_frame import DiscreteFilter
 from attitude_fmu.blocks.methods.registry import method as get_method
 from attitude_fmu.blocks.pipeline.batch import AttitudeEstimate, estimate
+from attitude_fmu.systems.cluster.jobs import Failure, Jobs
 from attitude_fmu.systems.simulation.motion import HumanMotion, Motion, incline_oscillation, steady_lever_arm
 from attitude_fmu.systems.simulation.sensor_model import ImuModel
 
@@ -67,24 +67,30 @@ def simulate_human(delta_n: float, delta_v: float, a: float = 1.0, method: str =
     return HumanRun(motion, est, start, g, len(acc) - start if offline else None)
 
 
+def table1_simulated(dn_deg: float, dv: float, a: float, duration: float, fs: float, seed: int) -> float:
+    """One simulated cell of Table 1, degrees RMS (δn in °/s/√Hz, δv in m/s/√Hz, slosh
+    mismatch a, duration in s, fs in Hz); a job of table1."""
+    return math.degrees(rms(simulate_human(math.radians(dn_deg), dv, a, duration=duration, fs=fs, seed=seed).errors))
+
+
 def table1(duration: float = 20000.0, fs: float = 100.0, seed: int = 0, rows=TABLE1_ROWS,
-           progress=True) -> list[dict]:
-    """Table 1 with analytic (eq. 50) and simulated RMS attitude errors side by side."""
+           progress=True, jobs: Jobs | None = None) -> list[dict]:
+    """Table 1 with analytic (eq. 50) and simulated RMS attitude errors side by side; each
+    simulated cell is a job of jobs (systems.cluster.jobs.Jobs; default: this process, a bar
+    when progress). A cell whose job failed (jobs reports it) has simulated_deg None."""
+    jobs = jobs or Jobs(bar=progress)
+    specs = [(dn_deg, dv, a, duration, fs, seed + 10 * i + j)
+             for i, (dn_deg, dv) in enumerate(rows) for j, a in enumerate(TABLE1_SLOSH)]
+    simulated = iter(jobs.map(table1_simulated, specs,
+                              [f"δn={c[0]}°/s/√Hz, δv={c[1]} m/s/√Hz, a={c[2]}" for c in specs], "cells"))
     table = []
-    total = len(rows) * len(TABLE1_SLOSH)
-    for i, (dn_deg, dv) in enumerate(rows):
+    for dn_deg, dv in rows:
         dn = math.radians(dn_deg)
         cells = []
-        for j, a in enumerate(TABLE1_SLOSH):
-            if progress:
-                print(f"table1: cell {i * len(TABLE1_SLOSH) + j + 1}/{total} "
-                      f"(δn={dn_deg}°/s/√Hz, δv={dv} m/s/√Hz, a={a})", file=sys.stderr, flush=True)
-            run = simulate_human(dn, dv, a, duration=duration, fs=fs, seed=seed + 10 * i + j)
-            cells.append({
-                "a": a,
-                "analytic_deg": math.degrees(accuracy.rms_attitude_error(dn, dv, a, PAPER_G)),
-                "simulated_deg": math.degrees(rms(run.errors)),
-            })
+        for a in TABLE1_SLOSH:
+            value = next(simulated)
+            cells.append({"a": a, "analytic_deg": math.degrees(accuracy.rms_attitude_error(dn, dv, a, PAPER_G)),
+                          "simulated_deg": None if isinstance(value, Failure) else value})
         table.append({
             "delta_n_deg": dn_deg, "delta_v": dv,
             "inv_omega_g_s": 1.0 / ef.omega_g(dn, dv, PAPER_G), "cells": cells,

@@ -23,7 +23,6 @@ agrees at every step), held within CHAIN_TOLERANCE. Each configuration runs the 
 from __future__ import annotations
 
 import math
-import sys
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -35,6 +34,7 @@ from attitude_fmu.blocks.filters import accuracy
 from attitude_fmu.blocks.filters.earth_filters import settle_time
 from attitude_fmu.blocks.methods.registry import METHODS
 from attitude_fmu.blocks.methods.registry import method as get_method
+from attitude_fmu.systems.cluster.jobs import Failure, Jobs
 from attitude_fmu.systems.fmi.cosim import cosimulate
 from attitude_fmu.systems.fmi.ssp import CHAINS, COMPONENTS, write_ssp
 from attitude_fmu.systems.simulation.motion import PROFILES
@@ -195,23 +195,23 @@ def chain_of(fmu_dir) -> str:
     return "native" if all((native / f"{fmu}.fmu").is_file() for fmu, _, _ in COMPONENTS.values()) else "python"
 
 
-def verify(fmu_dir, profiles=None, methods=None, step: float = STEP_S, progress: bool = True,
-           python: bool = False) -> list[dict]:
-    """Rows for every profile × method (default: all), on the native chain where it is built
-    (chain_of), with python the pythonfmu chain beside it (verify_one)."""
-    chain = chain_of(fmu_dir)
-    profiles = list(profiles or SCENARIOS)
-    methods = list(methods or METHODS)
-    rows = []
+def verify_job(fmu_dir, profile: str, method: str, step: float = STEP_S, chain: str = "native",
+               python: bool = False) -> dict:
+    """verify_one in a folder of its own; a job of verify."""
     with tempfile.TemporaryDirectory(prefix="attitude_verify_") as workdir:
-        for i, (profile, method) in enumerate((p, m) for p in profiles for m in methods):
-            label = f"verify: {i + 1}/{len(profiles) * len(methods)} {profile} × {method}"
-            tty = sys.stderr.isatty()
-            report = (lambda f, label=label: print(f"\r{label} {f:4.0%}", end="", file=sys.stderr, flush=True)) \
-                if progress and tty else None
-            if progress and not tty:
-                print(f"{label} …", file=sys.stderr, flush=True)
-            rows.append(verify_one(fmu_dir, profile, method, workdir, step, report, chain, python))
-            if progress:
-                print(f"\r{label} done", file=sys.stderr, flush=True)
-    return rows
+        return verify_one(fmu_dir, profile, method, workdir, step, chain=chain, python=python)
+
+
+def verify(fmu_dir, profiles=None, methods=None, step: float = STEP_S, progress: bool = True,
+           python: bool = False, jobs: Jobs | None = None) -> list[dict]:
+    """Rows for every profile × method (default: all), on the native chain where it is built
+    (chain_of), with python the pythonfmu chain beside it (verify_one). Each row is a job of
+    jobs (systems.cluster.jobs.Jobs; default: this process, a bar when progress), whose
+    workers see fmu_dir at its absolute path; a row whose job failed (jobs reports it) is left
+    out."""
+    chain = chain_of(fmu_dir)
+    runs = [(p, m) for p in list(profiles or SCENARIOS) for m in list(methods or METHODS)]
+    jobs = jobs or Jobs(bar=progress)
+    rows = jobs.map(verify_job, [(str(Path(fmu_dir).absolute()), p, m, step, chain, python) for p, m in runs],
+                    [f"{p} × {m}" for p, m in runs], "co-simulations")
+    return [row for row in rows if not isinstance(row, Failure)]

@@ -1,0 +1,177 @@
+"""Jobs: independent jobs run in this process or through dask.distributed, results in the
+jobs' order, a failed job reported while the others complete.
+
+A job is a module-level function of this package and its arguments (plain data: paths,
+numbers, small dicts), and returns plain data, so what a worker sends back is small.
+Recordings and FMUs reach workers as paths, which every worker must see (docs/distributed.md).
+A worker lost mid-run has its jobs rerun elsewhere by the scheduler (Dask's own retries,
+up to distributed.scheduler.allowed-failures times); a job that raises ValueError,
+OSError or RuntimeError (a damaged file, a bad option) is not retried: it is reported and
+gives a Failure, and the others complete. Other exceptions are faults of the code and propagate.
+"""
+from __future__ import annotations
+
+import importlib.metadata
+import os
+import sys
+import uuid
+from dataclasses import dataclass
+
+JOB_ERRORS = (ValueError, OSError, RuntimeError)  # a job's own failure, as the CLI reports them
+CONNECT_TIMEOUT_S = 10.0  # for --scheduler ADDRESS
+WORKER_PLUGIN = "attitude-fmu-worker-exit"
+
+
+@dataclass(frozen=True)
+class Failure:
+    """What Jobs.map gives for a job that failed: the message reported."""
+
+    message: str
+
+
+def default_workers() -> int:
+    """The number of cores (os.cpu_count(); 1 where it is not known)."""
+    return os.cpu_count() or 1
+
+
+def attempt(function, args: tuple) -> tuple[str, object]:
+    """function(*args) as ("ok", value), or ("error", message) for JOB_ERRORS; runs on a worker."""
+    try:
+        return "ok", function(*args)
+    except JOB_ERRORS as exc:
+        return "error", str(exc)
+
+
+def installed_version() -> str:
+    """This package's version where the call runs (a worker's, for Client.run)."""
+    return importlib.metadata.version("attitude-fmu")
+
+
+class Jobs:
+    """Runs independent jobs: in this process (workers=1), on a local cluster of that many
+    worker processes (one thread each) started on the first map with more than one job, or on
+    the Dask cluster whose scheduler is at scheduler (workers then ignored). bar: a progress
+    bar over the jobs on standard error when it is a terminal. Use as a context manager; the
+    cluster started here is closed on exit. failed: the names of the jobs that failed."""
+
+    def __init__(self, workers: int = 1, scheduler: str | None = None, bar: bool = True):
+        if scheduler is None and not (isinstance(workers, int) and workers >= 1):
+            raise ValueError(f"the number of workers must be a whole number ≥ 1, got {workers!r}")
+        self.workers, self.scheduler, self.bar = workers, scheduler, bar
+        self.failed: list[str] = []
+        self.client = None
+        self._cluster = None
+
+    def __enter__(self) -> Jobs:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def close(self) -> None:
+        if self.client is not None:
+            self.client.close()
+            self.client = None
+        if self._cluster is not None:
+            self._cluster.close()
+            self._cluster = None
+
+    def map(self, function, jobs, names, what: str = "jobs") -> list:
+        """[function(*job) for job in jobs] in the jobs' order, a Failure for a job that failed;
+        failures are reported on standard error in that order once every job has ended
+        (names: one per job, for the report; what: the jobs' plural noun and the bar's label)."""
+        jobs, names = list(jobs), list(names)
+        if len(names) != len(jobs):
+            raise ValueError(f"{len(jobs)} jobs need as many names, got {len(names)}")
+        from tqdm import tqdm
+
+        with tqdm(total=len(jobs), desc=what, unit="job", file=sys.stderr, leave=False,
+                  disable=not (self.bar and jobs and sys.stderr.isatty())) as bar:
+            if self.scheduler is not None or (self.workers > 1 and len(jobs) > 1):
+                outcomes = self._on_cluster(function, jobs, what, bar)
+            else:
+                outcomes = []
+                for job in jobs:
+                    outcomes.append(attempt(function, job))
+                    bar.update()
+        self._report(outcomes, names, what)
+        return [value if status == "ok" else Failure(value) for status, value in outcomes]
+
+    def _on_cluster(self, function, jobs, what, bar) -> list:
+        from distributed import KilledWorker, as_completed
+
+        client = self._start(len(jobs))
+        token = uuid.uuid4().hex[:12]
+        futures = [client.submit(attempt, function, job, key=f"{what.replace(' ', '-')}-{token}-{i}", pure=False,
+                                 priority=len(jobs) - i)  # submitted in order, started in order
+                   for i, job in enumerate(jobs)]
+        index = {future.key: i for i, future in enumerate(futures)}
+        outcomes = [None] * len(jobs)
+        for future in as_completed(futures):
+            try:
+                outcomes[index[future.key]] = future.result()
+            except KilledWorker as exc:
+                outcomes[index[future.key]] = ("error", (f"every worker that ran it died ({exc}); a job that ends "
+                                                         "its process (out of memory, a crash) is not retried further"))
+            future.release()
+            bar.update()
+        return outcomes
+
+    def _start(self, jobs: int):
+        """The client, connected on first use: to the scheduler, or to a local cluster of
+        min(workers, jobs) worker processes."""
+        if self.client is not None:
+            return self.client
+        import dask
+        from distributed import Client, LocalCluster
+
+        from attitude_fmu.systems.cluster.worker_exit import WorkerExit
+
+        if self.scheduler is None:
+            # glibc's own trim threshold, not Dask's 64 KiB: the jobs' many large temporaries
+            # otherwise cost them about 15 % (evaluate on BROAD)
+            environ = {name: value for name, value in dask.config.get("distributed.nanny.pre-spawn-environ").items()
+                       if name != "MALLOC_TRIM_THRESHOLD_"}
+            with dask.config.set({"distributed.nanny.pre-spawn-environ": environ}):
+                self._cluster = LocalCluster(n_workers=min(self.workers, jobs), threads_per_worker=1,
+                                             processes=True, dashboard_address="127.0.0.1:0",  # any free port
+                                             scheduler_kwargs={"dashboard": False})
+            self.client = Client(self._cluster)
+        else:
+            try:
+                self.client = Client(self.scheduler, timeout=CONNECT_TIMEOUT_S)
+            except (OSError, TimeoutError) as exc:
+                raise RuntimeError(f"cannot reach the Dask scheduler at {self.scheduler}: {exc}") from None
+            self._check_workers()
+        self.client.register_plugin(WorkerExit(always=self._cluster is not None), name=WORKER_PLUGIN)
+        return self.client
+
+    def _check_workers(self) -> None:
+        """Refuse a cluster without workers, or whose workers lack this package or run another version."""
+        if not self.client.scheduler_info(n_workers=-1)["workers"]:
+            raise RuntimeError(f"the Dask scheduler at {self.scheduler} has no workers; start some with: "
+                               f"dask worker {self.scheduler}")
+        try:
+            versions = self.client.run(installed_version)
+        except Exception as exc:  # the worker cannot unpickle a function of this package: it lacks it
+            raise RuntimeError(f"the workers of {self.scheduler} cannot run this package's jobs ({exc}); "
+                               "install attitude-fmu on every worker (docs/distributed.md)") from None
+        ours = installed_version()
+        other = {address: version for address, version in versions.items() if version != ours}
+        if other:
+            raise RuntimeError(f"workers of {self.scheduler} run attitude-fmu "
+                               f"{', '.join(f'{v} ({a})' for a, v in sorted(other.items()))}, this client {ours}; "
+                               "install the same version on every worker")
+
+    def _report(self, outcomes, names, what) -> None:
+        failed = [(i, names[i], message) for i, (status, message) in enumerate(outcomes) if status != "ok"]
+        self.failed += [name for _, name, _ in failed]
+        if len(outcomes) == 1 and failed:
+            print(f"attitude: error: {failed[0][2]}", file=sys.stderr)
+            return
+        for i, _, message in failed:
+            print(f"attitude: [{i + 1}/{len(outcomes)}] error: {message}", file=sys.stderr)
+        if failed:
+            rest = "the others completed" if len(failed) < len(outcomes) else "none completed"
+            print(f"attitude: error: {len(failed)} of {len(outcomes)} {what} failed "
+                  f"({', '.join(name for _, name, _ in failed)}); {rest}", file=sys.stderr)
