@@ -15,10 +15,11 @@ import numpy as np
 from attitude_fmu.blocks.filters import tseng
 from attitude_fmu.blocks.filters.sensor_frame import DiscreteFilter, sensor_frame_step
 from attitude_fmu.blocks.jit import kernel
-from attitude_fmu.blocks.methods.mahony import mahony_step
+from attitude_fmu.blocks.methods.mahony import check_gains, mahony_step
 
 
 def coefficients(params, Ts: float) -> np.ndarray:
+    check_gains(params["k_P"], params["k_I"], Ts)  # its Mahony mode's
     disc = DiscreteFilter.from_lti(tseng.earth_filter(), Ts)
     unit_rest = disc.rest_state([1.0, 0.0, 0.0])[:, 0]
     return np.concatenate([[disc.order, Ts, params["tol"], params["g"], params["k_P"], params["k_I"], disc.D],
