@@ -14,7 +14,8 @@ class Param:
     plausible range of its values, low ≤ value ≤ high in the same unit; 0 only where
     allow_zero (low is then 0), every other value strictly positive. A value outside is
     refused before any sample is taken (resolve_params); rules that depend on the sample
-    time are checked where the coefficients are made for one (blocks.methods.mahony)."""
+    time are checked where the coefficients are made for one (blocks.methods.mahony). choices,
+where given, are the only values taken (a switch such as 0 or 1)."""
 
     name: str
     default: float | None
@@ -23,12 +24,13 @@ class Param:
     allow_zero: bool = False
     low: float = 0.0
     high: float = math.inf
+    choices: tuple[float, ...] | None = None  # where only these values have a meaning (a switch)
 
     def range_text(self) -> str:
         """The plausible range as messages and the help say it: "[1e-07, 1] rad/s/√Hz", "(0, 100] s"."""
         low = "0" if self.allow_zero or self.low == 0 else f"{self.low:g}"
         bracket = "[" if self.allow_zero or self.low > 0 else "("
-        return f"{bracket}{low}, {self.high:g}] {self.unit}"
+        return f"{bracket}{low}, {self.high:g}]{_unit(self)}"
 
 
 def resolve_params(params: tuple[Param, ...], overrides: Mapping[str, float] | None, owner: str) -> dict:
@@ -45,11 +47,18 @@ def resolve_params(params: tuple[Param, ...], overrides: Mapping[str, float] | N
         if not (number and (value >= 0 if p.allow_zero else value > 0)):
             kind = "non-negative" if p.allow_zero else "positive"
             raise ValueError(f"parameter {name} must be a finite {kind} number ({p.range_text()}), got {value!r}")
+        if p.choices is not None and value not in p.choices:
+            raise ValueError(f"parameter {name} must be {' or '.join(f'{c:g}' for c in p.choices)}, got {value!r} "
+                             f"({p.doc})")
         if not p.low <= value <= p.high:
-            raise ValueError(f"parameter {name} = {value:g} {p.unit} is outside its plausible range "
+            raise ValueError(f"parameter {name} = {value:g}{_unit(p)} is outside its plausible range "
                              f"{p.range_text()} ({p.doc})")
         values[name] = float(value)
     return values
+
+
+def _unit(p: Param) -> str:
+    return "" if p.unit == "1" else f" {p.unit}"
 
 
 # plausible ranges shared by the parameters of one kind (Param's low and high, keyword arguments)

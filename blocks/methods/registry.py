@@ -68,7 +68,8 @@ MAHONY_GAINS = (  # Mahony's filter, alone and in Tseng's adaptive switch
 )
 LOCAL_NOISE_PARAMS = (
     Param("stationary", 0.0, "1", "0: omega_g from noise densities measured over the last tau_noise s "
-          "(blocks.methods.wiener_local); 1, or omega_g, omega_c or delta_v given: the stationary filter", True, high=1.0),
+          "(blocks.methods.wiener_local); 1, or omega_g, omega_c or delta_v given: the stationary filter", True, high=1.0,
+          choices=(0.0, 1.0)),
     Param("scale_error", 0.005, "1", "rms of each element of the gyro's scale-factor and misalignment "
           "error (datasheet)", True, high=1.0),
     Param("omega_m", 10.0, "rad/s", "band limit of the motion (velocity and rate) in the local densities", **FREQUENCY_RAD_S),
@@ -89,8 +90,6 @@ def _omega_g(p: Mapping[str, float | None]) -> float:
 
 
 def _wiener_is_local(p: Mapping[str, float | None]) -> bool:
-    if p["stationary"] not in (0.0, 1.0):
-        raise ValueError(f"parameter stationary must be 0 or 1, got {p['stationary']!r}")
     return p["stationary"] == 0.0 and p["omega_g"] is None and p["omega_c"] is None and p["delta_v"] is None
 
 

@@ -14,6 +14,8 @@ from attitude_fmu.blocks.methods.registry import METHODS
 from attitude_fmu.blocks.methods.registry import method as known_method
 from attitude_fmu.blocks.pipeline.causal import ESTIMATORS
 from attitude_fmu.blocks.stages.timing import ACC_SAMPLES, GYR_SAMPLES, check_latency
+from attitude_fmu.systems.recordings.output import STDIO, check_output, same_file
+from attitude_fmu.systems.recordings.writing import output_name
 from attitude_fmu.systems.recordings.reading import MAX_GAP_S
 from attitude_fmu.systems.recordings.recording import (
     ACC_UNITS,
@@ -230,21 +232,15 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _check_out(path, source=None, figure: bool = False) -> None:
-    """Refuse, before any work is done, an output file whose folder does not exist, that is
-    a folder, or that is the input file source (writing it would lose the recording); a
-    figure (figure=True) also in a format matplotlib cannot write."""
-    folder = Path(path).absolute().parent
-    if not folder.is_dir():
-        raise ValueError(f"cannot write {path}: there is no folder {folder}")
-    if Path(path).is_dir():
-        raise ValueError(f"cannot write {path}: it is a folder; give a file name")
-    if source is not None and Path(path).resolve() == Path(source).resolve():
-        raise ValueError(f"cannot write {path}: it is the input; choose another --out")
+    """Refuse, before any work is done, an output file that cannot be written or that is
+    the input file source (systems.recordings.output.check_output); a figure (figure=True)
+    also one in a format matplotlib cannot write."""
+    check_output(path, () if source is None else (source,))
     if figure:
         from matplotlib.figure import Figure
 
         formats = Figure().canvas.get_supported_filetypes()
-        if Path(path).suffix.lstrip(".").lower() not in formats:
+        if str(path) == STDIO or Path(path).suffix.lstrip(".").lower() not in formats:
             raise ValueError(f"cannot write {path}: a figure's file name ends in one of "
                              f"{', '.join('.' + f for f in sorted(formats))} (e.g. .png)")
 
@@ -252,14 +248,15 @@ def _check_out(path, source=None, figure: bool = False) -> None:
 def _estimate_outputs(inputs, out) -> list:
     """The output file of each input: out itself for one input, unless out is a folder; for
     several, out is a folder (made here if absent, its parent must exist). In a folder,
-    input NAME.ext gives out/NAME.csv. Refused before any work: two inputs of one name,
-    an output that is an input."""
+    input NAME.ext gives out/NAME.csv (NAME.parquet for a Parquet input). Refused before
+    any work: two inputs of one name, an output that is an input."""
     if len(inputs) == 1 and not Path(out).is_dir():
         _check_out(out, inputs[0])
         return [out]
     folder = Path(out)
-    if folder.exists() and not folder.is_dir():
-        raise ValueError(f"cannot write into {out}: with {len(inputs)} inputs --out is a folder, and it is a file")
+    if str(out) == STDIO or folder.exists() and not folder.is_dir():
+        raise ValueError(f"cannot write into {out}: with {len(inputs)} inputs --out is a folder, and it is "
+                         f"{'standard output' if str(out) == STDIO else 'a file'}")
     stems = [Path(path).stem for path in inputs]
     repeated = sorted({stem for stem in stems if stems.count(stem) > 1})
     if repeated:
@@ -267,12 +264,14 @@ def _estimate_outputs(inputs, out) -> list:
                          "each other; estimate them in separate runs")
     if not folder.is_dir():
         _check_out(folder)  # the folder to make: its parent must exist
-    outputs = [folder / f"{stem}.csv" for stem in stems]
+    outputs = [folder / output_name(path) for path in inputs]
     for path in outputs:
-        if any(path.resolve() == Path(source).resolve() for source in inputs):
+        if any(same_file(path, source) for source in inputs):
             raise ValueError(f"cannot write {path}: it is an input; choose another --out")
         if path.is_dir():
             raise ValueError(f"cannot write {path}: it is a folder")
+        if folder.is_dir():
+            check_output(path)
     folder.mkdir(exist_ok=True)
     return outputs
 
