@@ -331,7 +331,7 @@ def _estimate_one(args, path, out, prefix: str) -> None:
             extra["mag_offset"], extra["mag_delay"] = result.mag_offset, result.mag_delay
     write_estimate(out, rec.t[rows], result.quat[rows], result.up[rows], euler=args.euler,
                    extra={name: values[rows] for name, values in extra.items()})
-    progress(f"wrote {out}")
+    progress(f"wrote {'standard output' if str(out) == STDIO else out}")
     if result.offset is not None:
         print(f"attitude: {prefix}gyro offset estimate at the end "
               f"({', '.join(f'{v:.3f}' for v in np.degrees(result.offset[-1]))}) °/s", file=sys.stderr)

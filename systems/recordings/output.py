@@ -42,8 +42,12 @@ def check_output(path, inputs=(), what: str = "an output") -> None:
     for source in inputs:
         if str(source) != STDIO and (same_file(path, source) or path.absolute() == Path(source).absolute()):
             raise OutputError(f"cannot write {path}: it is the input; choose another --out (it is the file {source})")
-    if not os.access(folder, os.W_OK | os.X_OK):
-        raise OutputError(f"cannot write {path}: the folder {folder} does not let this user create files")
+    try:  # the one proof that the folder takes a file: making one
+        fd, trial = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".trial", dir=folder)
+        os.close(fd)
+        os.unlink(trial)
+    except OSError as exc:
+        raise OutputError(f"cannot write {path}: the folder {folder} takes no new file ({exc.strerror})") from None
     if path.exists() and not os.access(path, os.W_OK):
         raise OutputError(f"cannot write {path}: the file is read-only; choose another --out or make it writable")
 
@@ -58,7 +62,10 @@ def replaced(path):
         sys.stdout.buffer.flush()
         return
     path = Path(path)
-    fd, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".partial", dir=path.absolute().parent)
+    try:
+        fd, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".partial", dir=path.absolute().parent)
+    except OSError as exc:
+        raise OutputError(f"cannot write {path}: {exc.strerror}") from None
     try:
         with os.fdopen(fd, "wb") as fh:
             yield fh
@@ -66,9 +73,12 @@ def replaced(path):
             os.fsync(fh.fileno())
         os.chmod(temporary, _mode(path))
         os.replace(temporary, path)
-    except BaseException:
+    except BaseException as exc:
         with contextlib.suppress(OSError):
             os.unlink(temporary)
+        if isinstance(exc, OSError):  # a full disk, a quota, an I/O error: said, and what it left
+            kept = "is as it was" if path.exists() else "was not made"
+            raise OutputError(f"cannot write {path}: {exc.strerror or exc}; {path} {kept}") from None
         raise
 
 

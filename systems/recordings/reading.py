@@ -19,7 +19,8 @@ from attitude_fmu.systems.recordings.checks import (
     check_rate,
     check_shapes,
     check_values,
-    fill_non_finite,
+    fill_invalid,
+    hold_until_gravity,
     saturation_notes,
 )
 from attitude_fmu.systems.recordings.recording import (
@@ -59,7 +60,7 @@ def read_recording(path, fs: float | None = None, gyr_unit: str = "rad/s", acc_u
     (systems.recordings.axes.axes_notes). A CSV's time stamps may jitter and skip samples:
     runs of missing samples up to max_gap seconds are filled in (_fill_gaps), longer ones
     refused; so are runs of gyro or accelerometer values that are not finite
-    (fill_non_finite)."""
+    (fill_invalid), and samples beyond every IMU's range."""
     units = ((gyr_unit, GYR_UNITS), (acc_unit, ACC_UNITS), (mag_unit, MAG_UNITS), (t_unit, T_UNITS))
     if any(unit not in known for unit, known in units):
         raise RecordingError(f"units must be one of {', '.join(str(list(known)) for _, known in units)}")
@@ -99,8 +100,9 @@ def read_recording(path, fs: float | None = None, gyr_unit: str = "rad/s", acc_u
         rec.mag *= MAG_UNITS[mag_unit]
     check_shapes(rec)
     check_rate(rec.name, rec.fs)
-    fill_non_finite(rec, max_gap)
     check_values(rec, gyr_unit, acc_unit)
+    fill_invalid(rec, max_gap)
+    hold_until_gravity(rec)
     rec.notes += saturation_notes(rec)
     for name, matrix in maps.items():
         if getattr(rec, name) is not None:
