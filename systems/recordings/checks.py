@@ -107,18 +107,19 @@ def fill_invalid(rec: Recording, max_gap: float) -> None:
 
 def hold_until_gravity(rec: Recording) -> None:
     """Where the accelerometer shows no gravity at the start (norm below NO_GRAVITY_M_S2:
-    a sensor not yet powered, a logger's zeros), those rows take the first sample that
-    shows it, in place, and a note says so: the estimate starts there, never on "no
-    gravity" taken as down. check_values refuses an accelerometer without gravity
-    throughout."""
+    a sensor not yet powered, a logger's zeros), those rows are set to no sample (0), in
+    place, which the estimators wait over (blocks.pipeline.batch.estimate, as
+    OnlineEstimator): they start at rest on the first sample that shows gravity, never on
+    "no gravity" taken as down; a note says so. check_values refuses an accelerometer
+    without gravity throughout."""
     shows = np.einsum("ij,ij->i", rec.acc, rec.acc) >= NO_GRAVITY_M_S2**2
     first = int(np.argmax(shows))
     if first == 0 or not shows[first]:
         return
-    rec.acc[:first] = rec.acc[first]
+    rec.acc[:first] = 0.0
     rec.notes.append(f"{rec.name}: the accelerometer shows no gravity (norm below {NO_GRAVITY_M_S2:g} m/s²) in the "
-                     f"first {first} samples ({first / rec.fs:g} s): they hold sample {first + 1}, the first that "
-                     "shows it, and the estimate starts there")
+                     f"first {first} samples ({first / rec.fs:g} s): the estimate waits for sample {first + 1}, the "
+                     "first that shows it, and holds its start over them")
 
 
 def typical_peak(values) -> float:

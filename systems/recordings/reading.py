@@ -107,7 +107,7 @@ def read_recording(path, fs: float | None = None, gyr_unit: str = "rad/s", acc_u
     for name, matrix in maps.items():
         if getattr(rec, name) is not None:
             setattr(rec, name, getattr(rec, name) @ matrix.T)
-    rec.notes += axes_notes(rec.name, rec.gyr, rec.acc, rec.mag, rec.fs)
+    rec.notes += axes_notes(rec.name, rec.gyr, rec.acc, rec.mag, rec.fs, gyr_unit)
     return rec
 
 
