@@ -13,7 +13,6 @@ from dataclasses import dataclass
 from functools import lru_cache
 from typing import Callable, Mapping
 
-import control
 import numpy as np
 
 from attitude_fmu.blocks.filters import earth_filters as ef

@@ -45,6 +45,14 @@ def significant(x, digits: int = CSV_DIGITS) -> np.ndarray:
 _POWERS_OF_TEN = np.array([float(10 ** k) for k in range(23)])
 
 
+def _arrow(values: np.ndarray):
+    """A contiguous float64 numpy array as a pyarrow array on its memory (pyarrow's own
+    conversion imports pandas, a good part of a second at every start)."""
+    import pyarrow as pa
+
+    return pa.Array.from_buffers(pa.float64(), len(values), [None, pa.py_buffer(values)])
+
+
 def write_estimate(path, t, quat, up, euler: bool = False, extra=None) -> None:
     """Columns t,q_w,q_x,q_y,q_z,g_x,g_y,g_z (g the unit up-vector, sensor coordinates);
     euler adds roll, pitch and yaw in degrees (EULER_COLUMNS, euler_degrees); extra
@@ -71,7 +79,7 @@ def write_estimate(path, t, quat, up, euler: bool = False, extra=None) -> None:
             for _, values in blocks:
                 values = euler_degrees(quat[rows]) if values is None else values[rows]
                 columns += [np.ascontiguousarray(c, dtype=float) for c in values.T]
-            yield pa.record_batch([c if parquet else significant(c) for c in columns], schema=schema)
+            yield pa.RecordBatch.from_arrays([_arrow(c if parquet else significant(c)) for c in columns], schema=schema)
 
     with replaced(path) as fh:
         if parquet:
