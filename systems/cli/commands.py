@@ -224,10 +224,15 @@ def build_parser() -> argparse.ArgumentParser:
 
     bn = sub.add_parser("bench", help="samples per second of the batch estimator, vqf and ahrs Madgwick")
     bn.add_argument("--json", action="store_true")
-    bn.add_argument("--samples", type=int, default=100_000)
+    bn.add_argument("--samples", type=int, help="samples of the recording (default 100000; with --io 1000000)")
     bn.add_argument("--fmu", action="store_true",
                     help="per-step cost of AttitudeEstimator.fmu against a no-op FMU of the same interface")
-    bn.add_argument("--repeat", type=int, default=10, help="interleaved rounds; each method's best run counts (default 10)")
+    bn.add_argument("--io", action="store_true",
+                    help="attitude estimate end to end on a 9D recording at 1 kHz (--samples, default here 1000000), "
+                         "CSV to CSV and Parquet to Parquet, against pandas read_csv + vqf 9D + pandas to_csv; "
+                         "peak memory (needs pip install 'attitude-fmu[bench]')")
+    bn.add_argument("--repeat", type=int, default=10, help="interleaved rounds; each method's best run counts "
+                    "(default 10; with --io at most 3)")
     return parser
 
 
@@ -486,8 +491,18 @@ def cmd_bode(args) -> int:
 def cmd_bench(args) -> int:
     from attitude_fmu.systems.evaluation.bench import bench
 
+    args.samples = args.samples or (1_000_000 if args.io else 100_000)
     if args.samples < 1000 or args.repeat < 1:
         raise ValueError("--samples must be ≥ 1000 and --repeat ≥ 1")
+    if args.io:
+        from attitude_fmu.systems.evaluation.bench_io import bench_io, print_io
+
+        result = bench_io(args.samples, repeat=min(args.repeat, 3))
+        if args.json:
+            print(json.dumps(result, indent=2))
+        else:
+            print_io(result)
+        return 0
     if args.fmu:
         from attitude_fmu.systems.evaluation.bench import bench_fmu
 

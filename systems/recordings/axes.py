@@ -35,6 +35,7 @@ MIN_TURN_RAD = 0.3  # windows turning less than this from one to the next tell t
 MIN_WINDOWS = 20  # fewer turning pairs of windows than this: no verdict
 MISMATCH_RATIO = 4.0  # how much better a map must fit to be named
 SIGNIFICANT = 0.01  # nor is a mismatch below this share of the vector's mean square (≈ 6° of direction: drift's)
+WINDOW_SAMPLES = 100  # at most about this many samples of a window, evenly spread, enter its means
 
 
 def parse_axes(text: str) -> np.ndarray:
@@ -62,11 +63,17 @@ MAPS = [np.diag(signs)[list(order)] for order in itertools.permutations(range(3)
 # vector as P does, so of each pair the one that changes fewer signs stands for both
 
 
-def _orientations(gyr, fs: float) -> Rotation:
-    """The frame after each gyro sample (rad/s, mean rates) in the frame before the first."""
+def _orientations(gyr, fs: float, step: int = 1) -> Rotation:
+    """The frame after each step-th gyro sample (rad/s, mean rates; integrated over every
+    sample) in the frame before the first."""
     quat = np.empty((len(gyr), 4))
     integrate_rates(np.ascontiguousarray(gyr, dtype=float), 1.0 / fs, quat)
-    return Rotation.from_quat(quat, scalar_first=True)
+    return Rotation.from_quat(quat[step - 1::step], scalar_first=True)
+
+
+def _step(fs: float) -> int:
+    """Every how many samples one enters the window means at fs (Hz): WINDOW_SAMPLES a window."""
+    return max(1, _window(fs) // WINDOW_SAMPLES)
 
 
 def _window(fs: float) -> int:
@@ -157,31 +164,37 @@ def axes_note(name: str, what: str, flag: str, unit: str, scores: dict | None, m
 def axes_notes(name: str, gyr, acc, mag, fs: float, gyr_unit: str = "rad/s") -> list[str]:
     """The notes of axes_note on a recording's accelerometer and magnetometer (or None),
     or, where the gyro read in another unit than gyr_unit makes them turn as it says,
-    gyro_unit_note's instead."""
+    gyro_unit_note's instead. The gyro is integrated over every sample, the windows'
+    means are taken over every _step(fs)-th."""
     if len(gyr) // _window(fs) < MIN_WINDOWS:  # too short for a verdict (mismatches): nothing integrated
         return []
-    frames = {False: _orientations(gyr, fs), True: _orientations(-gyr, fs)}  # one integration each, for both sensors
+    step = _step(fs)
+    frames = {False: _orientations(gyr, fs, step), True: _orientations(-gyr, fs, step)}  # for both sensors
+    acc, mag, fs_used = acc[step - 1::step], None if mag is None else mag[step - 1::step], fs / step
     unit = gyro_unit_note(name, gyr, acc, mag, fs, gyr_unit, frames[False])
     if unit:
         return [unit]
     mean_square = lambda v: float(np.nanmean(np.sum(v**2, axis=1)))
-    notes = [axes_note(name, "the accelerometer", "--acc-axes", "m/s²", mismatches(frames, acc, fs), mean_square(acc))]
+    notes = [axes_note(name, "the accelerometer", "--acc-axes", "m/s²", mismatches(frames, acc, fs_used),
+                       mean_square(acc))]
     if mag is not None:
         notes.append(axes_note(name, "the magnetometer", "--mag-axes", "µT",
-                               mismatches(frames, mag, fs, hard_iron=True), mean_square(mag)))
+                               mismatches(frames, mag, fs_used, hard_iron=True), mean_square(mag)))
     return [note for note in notes if note]
 
 
 def gyro_unit_note(name: str, gyr, acc, mag, fs: float, gyr_unit: str, frames: Rotation) -> str | None:
-    """A note naming --gyr-unit where, with the gyro read in another unit (a factor of
-    57.3 or 1000 from gyr_unit; frames: those integrated from it as read), the
+    """A note naming --gyr-unit where, with the gyro (at fs, Hz) read in another unit (a
+    factor of 57.3 or 1000 from gyr_unit; frames: those integrated from it as read, at
+    every _step(fs)-th sample, as acc and mag are taken), the
     accelerometer and the magnetometer (if any) stay put in the gyro's frame
     MISMATCH_RATIO times better than as read, on every pair of windows whether the gyro
     says they turn or not; nothing where the mismatch as read is below SIGNIFICANT of the
     accelerometer's mean square."""
     sensors = [(acc, False)] + ([(mag, True)] if mag is not None else [])
-    score = lambda turned, v, hard_iron: (mismatches({False: turned}, v, fs, hard_iron, MAPS[:1], 0.0) or {}).get(
-        (0, False))
+    step = _step(fs)
+    score = lambda turned, v, hard_iron: (mismatches({False: turned}, v, fs / step, hard_iron, MAPS[:1], 0.0)
+                                          or {}).get((0, False))
     given = [score(frames, v, h) for v, h in sensors]
     if given[0] is None or given[0] < SIGNIFICANT * float(np.nanmean(np.sum(acc**2, axis=1))):
         return None
@@ -189,7 +202,7 @@ def gyro_unit_note(name: str, gyr, acc, mag, fs: float, gyr_unit: str, frames: R
         scale = factor / GYR_UNITS[gyr_unit]
         if unit == gyr_unit:
             continue
-        turned = _orientations(gyr * scale, fs)
+        turned = _orientations(gyr * scale, fs, step)
         fits = [score(turned, v, h) for v, h in sensors]
         if all(fit is not None and g is not None and MISMATCH_RATIO * fit < g for fit, g in zip(fits, given)):
             what = "the accelerometer and the magnetometer turn" if mag is not None else "the accelerometer turns"
