@@ -189,7 +189,7 @@ def gyro_unit_note(name: str, gyr, acc, mag, fs: float, gyr_unit: str, frames: R
     every _step(fs)-th sample, as acc and mag are taken), the
     accelerometer and the magnetometer (if any) stay put in the gyro's frame
     MISMATCH_RATIO times better than as read, on every pair of windows whether the gyro
-    says they turn or not; nothing where the mismatch as read is below SIGNIFICANT of the
+    says they turn or not (the unit that fits best); nothing where the mismatch as read is below SIGNIFICANT of the
     accelerometer's mean square."""
     sensors = [(acc, False)] + ([(mag, True)] if mag is not None else [])
     step = _step(fs)
@@ -198,16 +198,20 @@ def gyro_unit_note(name: str, gyr, acc, mag, fs: float, gyr_unit: str, frames: R
     given = [score(frames, v, h) for v, h in sensors]
     if given[0] is None or given[0] < SIGNIFICANT * float(np.nanmean(np.sum(acc**2, axis=1))):
         return None
+    candidates = {}  # unit → (scale, fits)
     for unit, factor in GYR_UNITS.items():
-        scale = factor / GYR_UNITS[gyr_unit]
-        if unit == gyr_unit:
-            continue
-        turned = _orientations(gyr * scale, fs, step)
-        fits = [score(turned, v, h) for v, h in sensors]
-        if all(fit is not None and g is not None and MISMATCH_RATIO * fit < g for fit, g in zip(fits, given)):
-            what = "the accelerometer and the magnetometer turn" if mag is not None else "the accelerometer turns"
-            return (f"{name}: {what} {scale:.3g} times {'more' if scale > 1 else 'less'} than the gyro read in "
-                    f"{gyr_unit} says (mean-square change of the accelerometer's {WINDOW_S:g}-s means in the gyro's "
-                    f"frame {given[0]:.3g} (m/s²)², read in {unit} {fits[0]:.3g}): is the gyro in {unit}? "
-                    f"pass --gyr-unit {unit}")
-    return None
+        if unit != gyr_unit:
+            scale = factor / GYR_UNITS[gyr_unit]
+            turned = _orientations(gyr * scale, fs, step)
+            candidates[unit] = scale, [score(turned, v, h) for v, h in sensors]
+    fitting = {unit: (scale, fits) for unit, (scale, fits) in candidates.items()
+               if all(fit is not None and g is not None and MISMATCH_RATIO * fit < g for fit, g in zip(fits, given))}
+    if not fitting:
+        return None
+    unit = min(fitting, key=lambda u: fitting[u][1][0])
+    scale, fits = fitting[unit]
+    what = "the accelerometer and the magnetometer turn" if mag is not None else "the accelerometer turns"
+    return (f"{name}: {what} {scale:.4g} times {'more' if scale > 1 else 'less'} than the gyro read in "
+            f"{gyr_unit} says (mean-square change of the accelerometer's {WINDOW_S:g}-s means in the gyro's "
+            f"frame {given[0]:.3g} (m/s²)², read in {unit} {fits[0]:.3g}): is the gyro in {unit}? "
+            f"pass --gyr-unit {unit}")

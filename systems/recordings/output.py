@@ -48,7 +48,7 @@ def check_output(path, inputs=(), what: str = "an output") -> None:
         os.unlink(trial)
     except OSError as exc:
         raise OutputError(f"cannot write {path}: the folder {folder} takes no new file ({exc.strerror})") from None
-    if path.exists() and not os.access(path, os.W_OK):
+    if path.exists() and not (os.access(path, os.W_OK) and os.stat(path).st_mode & 0o222):  # root too keeps it
         raise OutputError(f"cannot write {path}: the file is read-only; choose another --out or make it writable")
 
 
