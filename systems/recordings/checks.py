@@ -169,7 +169,8 @@ def check_values(rec: Recording, gyr_unit: str, acc_unit: str) -> None:
     if not finite.any():
         return  # fill_invalid refuses it
     peak = typical_peak(np.abs(rec.gyr[finite]).max(axis=1))
-    norm = float(np.median(np.linalg.norm(rec.acc[finite], axis=1)))
+    with np.errstate(over="ignore"):  # a norm beyond the largest float is inf, as far from gravity
+        norm = float(np.median(np.linalg.norm(rec.acc[finite], axis=1)))
     for flag, units, given, value, plausible, what in (
         ("--gyr-unit", GYR_UNITS, gyr_unit, peak, lambda p: p <= MAX_GYR_RAD_S,
          f"gyro reaches {peak:.1f} rad/s read as {gyr_unit}, beyond any MEMS gyro"),

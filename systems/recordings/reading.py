@@ -343,6 +343,7 @@ def _read_mat(source: Source, fs: float | None, columns: dict) -> Recording:
         fs = float(mat["sampling_rate"]) if "sampling_rate" in mat else fs
     except (TypeError, ValueError):
         raise RecordingError(f"{path}: sampling_rate must be one number (Hz)") from None
+    check_rate(path, fs)
     gyr, acc = (np.atleast_2d(_numbers(path, mat, key)) for key in ("imu_gyr", "imu_acc"))
     n = len(gyr)
     if gyr.ndim == acc.ndim == 2 and gyr.shape[1] == acc.shape[1] == 3 and len(acc) != n:

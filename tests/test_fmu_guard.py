@@ -1,0 +1,151 @@
+"""The pythonfmu FMUs' guard (fmu_src/fmi2_guard.c) against calls FMI 2.0 does not allow,
+built and run with AddressSanitizer and UBSan too; and the compiled kernels a fresh
+extraction of the same FMU finds in the per-user cache (blocks.jit)."""
+import math
+import os
+import shutil
+import subprocess
+import sys
+import textwrap
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+from fmpy import extract, read_model_description
+from fmpy.fmi1 import FMICallException
+
+from attitude_fmu.blocks.pipeline.batch import estimate
+from attitude_fmu.blocks.pipeline.online import OnlineEstimator
+from attitude_fmu.systems.fmi.build import build_fmus, compile_guard, python_environment
+from attitude_fmu.systems.fmi.cosim import FmuRunner
+from attitude_fmu.systems.simulation.motion import HumanMotion
+from attitude_fmu.systems.simulation.sensor_model import ImuModel
+
+INPUTS = [f"{s}_{a}" for s in ("gyr", "acc") for a in "xyz"]
+OUTPUTS = ["q_w", "q_x", "q_y", "q_z", "g_x", "g_y", "g_z"]
+FS = 100.0
+SANITIZERS = "-fsanitize=address,undefined"
+
+
+@pytest.fixture(scope="module")
+def fmu_dir(tmp_path_factory):
+    out = tmp_path_factory.mktemp("fmus")
+    build_fmus(out, ("AttitudeEstimator",))
+    return out
+
+
+def test_calls_in_the_wrong_phase_or_on_the_wrong_type_end_in_fmi2_error_and_harm_nothing(fmu_dir, capsys):
+    """Set and get on a value reference of another type or of none, doStep before
+    initialisation and after fmi2Terminate, fmi2Terminate twice: fmi2Error (3) with a
+    message, passed on to nothing; the instance then steps as the batch path, and after
+    fmi2Reset runs again."""
+    motion = HumanMotion(delta_v=0.1, omega_c=5.0).generate(1.0, FS, seed=41)
+    gyr, acc = ImuModel(delta_n=math.radians(0.05)).apply(motion, seed=42)
+    runner = FmuRunner(fmu_dir / "AttitudeEstimator.fmu", {"gyro_offset": "off"}, INPUTS, OUTPUTS, logging=True)
+    fmu, vr = runner.fmu, {n: v.valueReference for n, v in runner.variables.items()}
+
+    def status(call) -> int:
+        try:
+            call()
+        except FMICallException as exc:
+            return exc.status
+        return 0
+
+    fmu.reset()
+    statuses = {"doStep before initialisation": status(lambda: fmu.fmi2DoStep(fmu.component, 0.0, 1 / FS, 1))}
+    fmu.setupExperiment(startTime=0.0)
+    fmu.enterInitializationMode()
+    statuses.update({"setString on a Real": status(lambda: fmu.setString([vr["Ts"]], ["0.01"])),
+                     "setReal on a String": status(lambda: fmu.setReal([vr["method"]], [1.0])),
+                     "getReal on a Boolean": status(lambda: fmu.getReal([vr["valid"]])),
+                     "setReal on no variable": status(lambda: fmu.setReal([100000], [1.0]))})
+    fmu.setString([vr["gyro_offset"]], ["off"])
+    fmu.exitInitializationMode()
+    runner.time = 0.0
+    out, _ = runner.run(np.hstack([gyr, acc]), 1 / FS)
+    assert np.abs(out[:, :4] - estimate(gyr, acc, FS, gyro_offset=False).quat).max() < 1e-9
+    fmu.terminate()
+    statuses["doStep after terminate"] = status(lambda: fmu.fmi2DoStep(fmu.component, 1.0, 1 / FS, 1))
+    statuses["terminate twice"] = status(lambda: fmu.fmi2Terminate(fmu.component))
+    assert statuses == dict.fromkeys(statuses, 3), statuses
+    log = capsys.readouterr().out
+    for message in ("fmi2DoStep refused: not allowed before initialisation",
+                    f"fmi2SetString refused: value reference {vr['Ts']} is a Real variable, not a String",
+                    f"fmi2SetReal refused: value reference {vr['method']} is a String variable, not a Real",
+                    "fmi2SetReal refused: value reference 100000 names no variable",
+                    "fmi2DoStep refused: not allowed after fmi2Terminate"):
+        assert message in log, log
+    runner.fmu.reset()
+    runner._initialise()
+    again, _ = runner.run(np.hstack([gyr, acc]), 1 / FS)
+    runner.close()
+    assert np.array_equal(again, out)
+
+
+def test_the_guard_under_address_and_undefined_behaviour_sanitizers(fmu_dir, tmp_path, monkeypatch):
+    """The guard and a C importer without Python (tests/fmi_host.c) built with
+    -fsanitize=address,undefined: the steps give blocks.pipeline.online's estimate, the
+    calls FMI 2.0 does not allow end in fmi2Error, and no sanitizer reports anything."""
+    cc = os.environ.get("CC") or "cc"
+    if shutil.which(cc.split()[0]) is None:
+        pytest.skip("no C compiler")
+    if not any(python_environment().splitlines()[:2]):
+        pytest.skip("this Python has no shared libpython to start in another process")
+    host = tmp_path / "fmi_host"
+    subprocess.run([*cc.split(), "-std=c99", "-Wall", "-Wextra", "-Werror", SANITIZERS, "-fno-omit-frame-pointer",
+                    "-o", str(host), str(Path(__file__).parent / "fmi_host.c"), "-ldl"], check=True)
+    monkeypatch.setenv("CC", f"{cc} -std=c99 -Wall -Wextra -Werror {SANITIZERS} -fno-omit-frame-pointer")
+    said = []
+    guard = compile_guard(tmp_path / "guard.so", log=said.append)
+    assert guard is not None, said
+    fmu = tmp_path / "AttitudeEstimator.fmu"  # the built FMU with the sanitized guard as its binary
+    binary = "binaries/linux64/AttitudeEstimator.so"
+    with zipfile.ZipFile(fmu_dir / "AttitudeEstimator.fmu") as src, zipfile.ZipFile(fmu, "w") as dst:
+        for item in src.infolist():
+            dst.writestr(item, guard.read_bytes() if item.filename == binary else src.read(item))
+    md = read_model_description(str(fmu))
+    unzipped = Path(extract(str(fmu), unzipdir=str(tmp_path / "unzipped")))
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    u = [0.3, -0.1, 0.05, 1.0, 2.0, 9.5]
+    args = [str(host), str(unzipped / "binaries" / "linux64" / "AttitudeEstimator.so"), md.guid,
+            (unzipped / "resources").as_uri(), "50", str(1 / FS), *(str(vr[n]) for n in INPUTS), "--",
+            *(repr(v) for v in u), "--", *(str(vr[n]) for n in OUTPUTS), "--", str(vr["method"])]
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME", "VIRTUAL_ENV")}
+    env["ASAN_OPTIONS"] = "detect_leaks=0"  # the embedded interpreter keeps its memory to the end, by design
+    env["UBSAN_OPTIONS"] = "print_stacktrace=1"
+    proc = subprocess.run(args, capture_output=True, text=True, env=env, timeout=600)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    assert "misuse 3 3 3" in proc.stderr, proc.stderr[-3000:]
+    assert "runtime error" not in proc.stderr and "AddressSanitizer" not in proc.stderr, proc.stderr[-3000:]
+    online = OnlineEstimator(gyro_offset=True)  # the FMU's default
+    for _ in range(50):
+        online.step(u[:3], u[3:], 1 / FS)
+    assert np.abs(np.array(proc.stdout.split(), dtype=float) - np.r_[online.quat, online.up]).max() < 1e-9
+
+
+def test_a_fresh_extraction_finds_the_kernels_another_extraction_compiled(fmu_dir, tmp_path):
+    """Two extractions of one FMU in two processes, one per-user cache (ATTITUDE_FMU_CACHE):
+    the second loads every kernel the first compiled and compiles none."""
+    fmu = str(fmu_dir / "AttitudeEstimator.fmu")
+    script = textwrap.dedent("""
+        import sys
+        sys.path.insert(0, sys.argv[1])
+        import numpy as np
+        from attitude_fmu.blocks.quaternion import integrate_rates
+        quat = np.empty((5, 4))
+        integrate_rates(np.full((5, 3), 0.1), 0.01, quat)
+        print(quat[-1].tolist())
+    """)
+    env = {**os.environ, "ATTITUDE_FMU_CACHE": str(tmp_path / "cache"), "NUMBA_DEBUG_CACHE": "1"}
+    env.pop("NUMBA_CACHE_DIR", None)
+    runs = []
+    for k in range(2):
+        resources = Path(extract(fmu, unzipdir=str(tmp_path / f"x{k}"))) / "resources"
+        runs.append(subprocess.run([sys.executable, "-c", script, str(resources)], capture_output=True, text=True,
+                                   env=env, cwd=tmp_path, timeout=600))
+        assert runs[-1].returncode == 0, runs[-1].stderr[-2000:]
+    first, second = (run.stdout for run in runs)
+    assert "data saved to" in first and "[cache] data loaded from" in second, second
+    assert "data saved to" not in second and str(tmp_path / "cache") in second
+    assert first.splitlines()[-1] == second.splitlines()[-1]
