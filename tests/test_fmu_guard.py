@@ -1,38 +1,23 @@
-"""The pythonfmu FMUs' guard (fmu_src/fmi2_guard.c) against calls FMI 2.0 does not allow,
-built and run with AddressSanitizer and UBSan too; and the compiled kernels a fresh
-extraction of the same FMU finds in the per-user cache (blocks.jit)."""
+"""The pythonfmu FMUs' guard (fmu_src/fmi2_guard.c) against calls FMI 2.0 does not allow
+(under the sanitizers: tests/test_fmu.py's importer without Python); and the compiled
+kernels a fresh extraction of the same FMU finds in the per-user cache (blocks.jit)."""
 import math
 import os
-import shutil
 import subprocess
 import sys
 import textwrap
-import zipfile
 from pathlib import Path
 
 import numpy as np
 import pytest
-from fmpy import extract, read_model_description
+from fmpy import extract
 from fmpy.fmi1 import FMICallException
 
 from attitude_fmu.blocks.pipeline.batch import estimate
-from attitude_fmu.blocks.pipeline.online import OnlineEstimator
-from attitude_fmu.systems.fmi.build import build_fmus, compile_guard, python_environment
 from attitude_fmu.systems.fmi.cosim import FmuRunner
 from attitude_fmu.systems.simulation.motion import HumanMotion
 from attitude_fmu.systems.simulation.sensor_model import ImuModel
-
-INPUTS = [f"{s}_{a}" for s in ("gyr", "acc") for a in "xyz"]
-OUTPUTS = ["q_w", "q_x", "q_y", "q_z", "g_x", "g_y", "g_z"]
-FS = 100.0
-SANITIZERS = "-fsanitize=address,undefined"
-
-
-@pytest.fixture(scope="module")
-def fmu_dir(tmp_path_factory):
-    out = tmp_path_factory.mktemp("fmus")
-    build_fmus(out, ("AttitudeEstimator",))
-    return out
+from tests.test_fmu import FS, INPUTS, OUTPUTS, fmu_dir  # noqa: F401 (fmu_dir: the FMUs, built once here)
 
 
 def test_calls_in_the_wrong_phase_or_on_the_wrong_type_end_in_fmi2_error_and_harm_nothing(fmu_dir, capsys):
@@ -81,47 +66,6 @@ def test_calls_in_the_wrong_phase_or_on_the_wrong_type_end_in_fmi2_error_and_har
     again, _ = runner.run(np.hstack([gyr, acc]), 1 / FS)
     runner.close()
     assert np.array_equal(again, out)
-
-
-def test_the_guard_under_address_and_undefined_behaviour_sanitizers(fmu_dir, tmp_path, monkeypatch):
-    """The guard and a C importer without Python (tests/fmi_host.c) built with
-    -fsanitize=address,undefined: the steps give blocks.pipeline.online's estimate, the
-    calls FMI 2.0 does not allow end in fmi2Error, and no sanitizer reports anything."""
-    cc = os.environ.get("CC") or "cc"
-    if shutil.which(cc.split()[0]) is None:
-        pytest.skip("no C compiler")
-    if not any(python_environment().splitlines()[:2]):
-        pytest.skip("this Python has no shared libpython to start in another process")
-    host = tmp_path / "fmi_host"
-    subprocess.run([*cc.split(), "-std=c99", "-Wall", "-Wextra", "-Werror", SANITIZERS, "-fno-omit-frame-pointer",
-                    "-o", str(host), str(Path(__file__).parent / "fmi_host.c"), "-ldl"], check=True)
-    monkeypatch.setenv("CC", f"{cc} -std=c99 -Wall -Wextra -Werror {SANITIZERS} -fno-omit-frame-pointer")
-    said = []
-    guard = compile_guard(tmp_path / "guard.so", log=said.append)
-    assert guard is not None, said
-    fmu = tmp_path / "AttitudeEstimator.fmu"  # the built FMU with the sanitized guard as its binary
-    binary = "binaries/linux64/AttitudeEstimator.so"
-    with zipfile.ZipFile(fmu_dir / "AttitudeEstimator.fmu") as src, zipfile.ZipFile(fmu, "w") as dst:
-        for item in src.infolist():
-            dst.writestr(item, guard.read_bytes() if item.filename == binary else src.read(item))
-    md = read_model_description(str(fmu))
-    unzipped = Path(extract(str(fmu), unzipdir=str(tmp_path / "unzipped")))
-    vr = {v.name: v.valueReference for v in md.modelVariables}
-    u = [0.3, -0.1, 0.05, 1.0, 2.0, 9.5]
-    args = [str(host), str(unzipped / "binaries" / "linux64" / "AttitudeEstimator.so"), md.guid,
-            (unzipped / "resources").as_uri(), "50", str(1 / FS), *(str(vr[n]) for n in INPUTS), "--",
-            *(repr(v) for v in u), "--", *(str(vr[n]) for n in OUTPUTS), "--", str(vr["method"])]
-    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME", "VIRTUAL_ENV")}
-    env["ASAN_OPTIONS"] = "detect_leaks=0"  # the embedded interpreter keeps its memory to the end, by design
-    env["UBSAN_OPTIONS"] = "print_stacktrace=1"
-    proc = subprocess.run(args, capture_output=True, text=True, env=env, timeout=600)
-    assert proc.returncode == 0, proc.stderr[-3000:]
-    assert "misuse 3 3 3" in proc.stderr, proc.stderr[-3000:]
-    assert "runtime error" not in proc.stderr and "AddressSanitizer" not in proc.stderr, proc.stderr[-3000:]
-    online = OnlineEstimator(gyro_offset=True)  # the FMU's default
-    for _ in range(50):
-        online.step(u[:3], u[3:], 1 / FS)
-    assert np.abs(np.array(proc.stdout.split(), dtype=float) - np.r_[online.quat, online.up]).max() < 1e-9
 
 
 def test_a_fresh_extraction_finds_the_kernels_another_extraction_compiled(fmu_dir, tmp_path):
