@@ -15,7 +15,6 @@ from attitude_fmu.blocks.methods.registry import method as known_method
 from attitude_fmu.blocks.pipeline.causal import ESTIMATORS
 from attitude_fmu.blocks.stages.timing import ACC_SAMPLES, GYR_SAMPLES, check_latency
 from attitude_fmu.systems.recordings.output import STDIO, check_output, same_file
-from attitude_fmu.systems.recordings.writing import output_name
 from attitude_fmu.systems.recordings.reading import MAX_GAP_S
 from attitude_fmu.systems.recordings.recording import (
     ACC_UNITS,
@@ -27,6 +26,7 @@ from attitude_fmu.systems.recordings.recording import (
     REF_COLUMNS,
     T_UNITS,
 )
+from attitude_fmu.systems.recordings.writing import output_name
 
 EXIT_BAD_INPUT = 2
 EXIT_CHECK_FAILED = 1
@@ -73,7 +73,7 @@ def _method_help() -> str:
         lines.append(title)
         for p in params:
             default = "unset" if p.default is None else f"{p.default:g}"
-            lines.append(f"    {p.name} [{p.unit}] (default {default}): {p.doc}")
+            lines.append(f"    {p.name} [{p.unit}] (default {default}): {p.doc}; plausible {p.range_text()}")
     return "\n".join(lines)
 
 
