@@ -19,7 +19,16 @@ from attitude_fmu.blocks.filters import earth_filters as ef
 from attitude_fmu.blocks.filters import tseng
 from attitude_fmu.blocks.filters.sensor_frame import DiscreteFilter, SensorFrameStepper, stepper_system
 from attitude_fmu.blocks.methods import luinge, mahony, tseng_adaptive, wiener_local
-from attitude_fmu.blocks.params import ANGLE_RAD, FREQUENCY_RAD_S, GRAVITY_M_S2, GYRO_NOISE, Param, SLOSH, TIME_S, resolve_params
+from attitude_fmu.blocks.params import (
+    ANGLE_RAD,
+    FREQUENCY_RAD_S,
+    GRAVITY_M_S2,
+    GYRO_NOISE,
+    SLOSH,
+    TIME_S,
+    Param,
+    resolve_params,
+)
 
 
 @dataclass(frozen=True)
@@ -58,7 +67,8 @@ NOMINAL_DELTA_V = 1.0  # m/s/√Hz: vigorous human motion (Rizun's Table 1), whe
 NOISE_PARAMS = (
     Param("delta_n", math.radians(0.1), "rad/s/√Hz", "gyro noise density, one-sided (datasheet)", **GYRO_NOISE),
     Param("delta_v", None, "m/s/√Hz",
-          f"slosh: density of the velocity of the motion (eq. 14); unset: {NOMINAL_DELTA_V:g} for the stationary filter", **SLOSH),
+          f"slosh: density of the velocity of the motion (eq. 14); unset: {NOMINAL_DELTA_V:g} for the stationary filter",
+          **SLOSH),
     Param("g", ef.STANDARD_GRAVITY, "m/s²", "magnitude of gravity", **GRAVITY_M_S2),
 )
 MAHONY_GAINS = (  # Mahony's filter, alone and in Tseng's adaptive switch
@@ -67,11 +77,12 @@ MAHONY_GAINS = (  # Mahony's filter, alone and in Tseng's adaptive switch
 )
 LOCAL_NOISE_PARAMS = (
     Param("stationary", 0.0, "1", "0: omega_g from noise densities measured over the last tau_noise s "
-          "(blocks.methods.wiener_local); 1, or omega_g, omega_c or delta_v given: the stationary filter", True, high=1.0,
-          choices=(0.0, 1.0)),
+          "(blocks.methods.wiener_local); 1, or omega_g, omega_c or delta_v given: the stationary filter",
+          True, high=1.0, choices=(0.0, 1.0)),
     Param("scale_error", 0.005, "1", "rms of each element of the gyro's scale-factor and misalignment "
           "error (datasheet)", True, high=1.0),
-    Param("omega_m", 10.0, "rad/s", "band limit of the motion (velocity and rate) in the local densities", **FREQUENCY_RAD_S),
+    Param("omega_m", 10.0, "rad/s", "band limit of the motion (velocity and rate) in the local densities",
+          **FREQUENCY_RAD_S),
     Param("tau_noise", 1.0, "s", "averaging time of the local densities", **TIME_S),
     Param("tau_v", 1.0, "s", "time constant of the band-pass that turns the accelerometer into the "
           "slosh velocity", **TIME_S),
@@ -109,8 +120,10 @@ METHODS: dict[str, Method] = {
         "Rizun's optimal Wiener filter: eq. 34 (Butterworth) with omega_g from local noise densities; "
         "with stationary=1 eq. 34 at fixed densities, or eq. 33 when omega_c is given",
         NOISE_PARAMS + (
-            Param("omega_g", None, "rad/s", "break frequency; default sqrt(g·delta_n/delta_v), eq. 25", **FREQUENCY_RAD_S),
-            Param("omega_c", None, "rad/s", "band limit of the motion; given, eq. 33 replaces eq. 34", **FREQUENCY_RAD_S),
+            Param("omega_g", None, "rad/s", "break frequency; default sqrt(g·delta_n/delta_v), eq. 25",
+                  **FREQUENCY_RAD_S),
+            Param("omega_c", None, "rad/s", "band limit of the motion; given, eq. 33 replaces eq. 34",
+                  **FREQUENCY_RAD_S),
         ) + LOCAL_NOISE_PARAMS,
         _design_wiener,
         kernel=wiener_local,
@@ -126,7 +139,8 @@ METHODS: dict[str, Method] = {
         "tseng_adaptive",
         "Tseng's adaptive filter: complementary filter, Mahony's filter while |acc| leaves g by > tol",
         (
-            Param("tol", 0.5, "m/s²", "accelerometer norm's distance from g that switches to Mahony's filter", low=1e-4, high=400.0 * 9.80665),
+            Param("tol", 0.5, "m/s²", "accelerometer norm's distance from g that switches to Mahony's filter",
+                  low=1e-4, high=400.0 * 9.80665),
             *MAHONY_GAINS,
             Param("g", ef.STANDARD_GRAVITY, "m/s²", "magnitude of gravity", **GRAVITY_M_S2),
         ),
@@ -136,9 +150,11 @@ METHODS: dict[str, Method] = {
         "luinge",
         "Luinge's tilt Kalman filter: gyro orientation, 2-state KF on the tilt difference",
         (
-            Param("delta_n", math.radians(0.1), "rad/s/√Hz", "gyro noise density (process noise of the tilt)", **GYRO_NOISE),
+            Param("delta_n", math.radians(0.1), "rad/s/√Hz", "gyro noise density (process noise of the tilt)",
+                  **GYRO_NOISE),
             Param("tilt_sd", 0.05, "rad", "s.d. of the accelerometer's tilt (acceleration as noise)", **ANGLE_RAD),
-            Param("g", ef.STANDARD_GRAVITY, "m/s²", "magnitude of gravity (scales the gravity output)", **GRAVITY_M_S2),
+            Param("g", ef.STANDARD_GRAVITY, "m/s²", "magnitude of gravity (scales the gravity output)",
+                  **GRAVITY_M_S2),
         ),
         kernel=luinge,
     ),
@@ -146,7 +162,8 @@ METHODS: dict[str, Method] = {
         "mahony",
         "Mahony's complementary filter on SO(3) with gyro-bias estimation (IEEE TAC 53, 2008)",
         MAHONY_GAINS + (
-            Param("g", ef.STANDARD_GRAVITY, "m/s²", "magnitude of gravity (scales the gravity output)", **GRAVITY_M_S2),
+            Param("g", ef.STANDARD_GRAVITY, "m/s²", "magnitude of gravity (scales the gravity output)",
+                  **GRAVITY_M_S2),
         ),
         kernel=mahony,
     ),
@@ -156,7 +173,8 @@ METHODS: dict[str, Method] = {
         NOISE_PARAMS + (
             Param("omega_g", None, "rad/s", "Wiener break frequency the best cut-off derives from", **FREQUENCY_RAD_S),
             Param("omega_c", 10.0, "rad/s", "band limit of the motion (for the best cut-off)", **FREQUENCY_RAD_S),
-            Param("omega_f", None, "rad/s", "cut-off; default (omega_g⁴/(2·omega_c))^(1/3), the best", **FREQUENCY_RAD_S),
+            Param("omega_f", None, "rad/s", "cut-off; default (omega_g⁴/(2·omega_c))^(1/3), the best",
+                  **FREQUENCY_RAD_S),
         ),
         _design_first_order,
     ),

@@ -120,8 +120,8 @@ def print_io(result: dict) -> None:
     """bench_io's result as a table."""
     mb = lambda b: f"{b / 1e6:.0f} MB"
     rec = result["recording"]
-    print(f"{result['samples']} samples at {result['fs_hz']:g} Hz with a magnetometer: columns {mb(rec['array_bytes'])}, "
-          f"CSV {mb(rec['csv_bytes'])}, Parquet {mb(rec['parquet_bytes'])}; best of the rounds")
+    print(f"{result['samples']} samples at {result['fs_hz']:g} Hz with a magnetometer: "
+          f"columns {mb(rec['array_bytes'])}, CSV {mb(rec['csv_bytes'])}, Parquet {mb(rec['parquet_bytes'])}; best of the rounds")
     for name, seconds in result["seconds"].items():
         memory = result["peak_memory_bytes"].get(name)
         print(f"{name:>22} {seconds:7.2f} s {result['ratio_vs_peers'][name]:6.2f}×"

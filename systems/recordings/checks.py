@@ -80,7 +80,8 @@ def fill_invalid(rec: Recording, max_gap: float) -> None:
     if not bad_rows.any():
         return
     what = {(False, True): "not finite", (True, False): f"beyond every IMU's range ({RANGES})",
-            (True, True): f"not finite or beyond every IMU's range ({RANGES})"}[beyond.any(), (bad_rows & ~beyond).any()]
+            (True, True): f"not finite or beyond every IMU's range ({RANGES})"}[
+        beyond.any(), (bad_rows & ~beyond).any()]
     rows = np.flatnonzero(bad_rows)
     starts = rows[np.concatenate([[True], np.diff(rows) > 1])]
     ends = rows[np.concatenate([np.diff(rows) > 1, [True]])]

@@ -114,7 +114,8 @@ def csv_numbers(source: Source, delimiter: str, width: int, skip: int, bad_line)
             read_options=pc.ReadOptions(skip_rows=skip, column_names=names),
             parse_options=pc.ParseOptions(delimiter=delimiter, invalid_row_handler=_comment_row),
             convert_options=pc.ConvertOptions(column_types={n: pa.float64() for n in names}, null_values=[],
-                                              strings_can_be_null=False, decimal_point="." if delimiter == "," else ","))
+                                              strings_can_be_null=False,
+                                              decimal_point="." if delimiter == "," else ","))
     except (pa.ArrowInvalid, pa.ArrowNotImplementedError):
         return _loadtxt(source, delimiter, width, skip, bad_line)
     return Columns(table.num_rows, lambda i: floats(table.column(i)))

@@ -92,6 +92,7 @@ def write_estimate(path, t, quat, up, euler: bool = False, extra=None) -> None:
         import pyarrow.csv as pc
 
         fh.write((",".join(names) + "\n").encode())  # the header unquoted, as the columns are
-        with pc.CSVWriter(fh, schema, write_options=pc.WriteOptions(include_header=False, quoting_style="none")) as writer:
+        options = pc.WriteOptions(include_header=False, quoting_style="none")
+        with pc.CSVWriter(fh, schema, write_options=options) as writer:
             for batch in batches():
                 writer.write_batch(batch)
