@@ -8,12 +8,15 @@ Compiled kernels are cached per user, in a folder keyed by the fingerprint of th
 not by where the sources are: every copy of the same sources, an installed package or each
 fresh extraction of an FMU that carries them, finds what another compiled. The folder is
 $ATTITUDE_FMU_CACHE, else $XDG_CACHE_HOME/attitude_fmu, else ~/.cache/attitude_fmu; where
-none can be written, numba's own places are used, and NUMBA_CACHE_DIR, where set, wins.
+none can be written, numba's own places are used, and NUMBA_CACHE_DIR, where set, wins. An
+installed package brings the kernels of the command line's first run compiled at its build
+(SHIPPED; setup.py): a folder that does not exist yet starts as a copy of them.
 """
 from __future__ import annotations
 
 import hashlib
 import os
+import shutil
 import sys
 from pathlib import Path
 
@@ -28,6 +31,7 @@ except ImportError:  # pragma: no cover - exercised by the FMU's fresh-environme
 FASTMATH = {"contract", "reassoc", "arcp", "nsz"}
 PACKAGE_ROOT = Path(__file__).resolve().parent.parent  # attitude_fmu's folder (an FMU's resources/attitude_fmu)
 KERNEL_FOLDERS = ("blocks", "systems")  # the package's folders that hold kernels, and what they import
+SHIPPED = "kernel_cache"  # in an installed package: the kernels compiled ahead at its build (setup.py)
 
 
 def sources_fingerprint(root: Path = PACKAGE_ROOT) -> str:
@@ -47,6 +51,20 @@ def cache_folder() -> Path:
     return Path(base) / version / sources_fingerprint()[:20]
 
 
+def _seed(folder: Path) -> None:
+    """folder (cache_folder) made from the kernels compiled ahead at the package's build
+    (PACKAGE_ROOT/kernel_cache, the same layout: systems.cli.first_run), where it has none."""
+    shipped = PACKAGE_ROOT / SHIPPED / folder.parent.name / folder.name
+    if folder.exists() or not shipped.is_dir():
+        return
+    staged = folder.with_name(f".{folder.name}.{os.getpid()}")
+    shutil.copytree(shipped, staged)
+    try:
+        os.rename(staged, folder)  # whole or not at all; another process may have made it meanwhile
+    except OSError:
+        shutil.rmtree(staged, ignore_errors=True)
+
+
 def _register_cache_locator() -> None:
     """Put the per-user cache (cache_folder) first among numba's cache locators, for the
     kernels of this package; numba's own locators serve every other file."""
@@ -56,7 +74,8 @@ def _register_cache_locator() -> None:
         return
     try:
         folder = cache_folder()
-    except (OSError, RuntimeError):  # no home folder
+        _seed(folder)
+    except (OSError, RuntimeError):  # no home folder, none that takes files
         return
 
     class SourcesCacheLocator(caching._CacheLocator):

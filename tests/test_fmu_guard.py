@@ -93,3 +93,24 @@ def test_a_fresh_extraction_finds_the_kernels_another_extraction_compiled(fmu_di
     assert "data saved to" in first and "[cache] data loaded from" in second, second
     assert "data saved to" not in second and str(tmp_path / "cache") in second
     assert first.splitlines()[-1] == second.splitlines()[-1]
+
+
+def test_the_kernels_compiled_at_the_build_seed_a_per_user_folder_that_has_none(tmp_path, monkeypatch):
+    """blocks.jit._seed: a cache folder that does not exist starts as a copy of the
+    package's kernel_cache/ (setup.py compiles it at the build); one that exists is left
+    as it is."""
+    from attitude_fmu.blocks import jit
+
+    package = tmp_path / "attitude_fmu"
+    shipped = package / jit.SHIPPED / "numba-x-py3" / "fingerprint" / "blocks"
+    shipped.mkdir(parents=True)
+    (shipped / "kernel.nbi").write_bytes(b"index")
+    monkeypatch.setattr(jit, "PACKAGE_ROOT", package)
+    folder = tmp_path / "user" / "numba-x-py3" / "fingerprint"
+    folder.parent.mkdir(parents=True)
+    jit._seed(folder)
+    assert (folder / "blocks" / "kernel.nbi").read_bytes() == b"index"
+    (shipped / "kernel.nbi").write_bytes(b"newer")
+    jit._seed(folder)
+    assert (folder / "blocks" / "kernel.nbi").read_bytes() == b"index"
+    assert sorted(p.name for p in folder.parent.iterdir()) == ["fingerprint"]  # no staging folder left
