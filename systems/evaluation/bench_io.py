@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import contextlib
 import io
-import os
 import subprocess
 import sys
 import tempfile
@@ -62,14 +61,24 @@ def _peers(source: Path, out: Path) -> None:
     table.to_csv(out, index=False, float_format=f"%.{CSV_DIGITS}g")
 
 
+PEAK_SCRIPT = """
+import sys
+from attitude_fmu.systems.cli.commands import main
+code = main(sys.argv[1:])
+status = dict(line.split(":", 1) for line in open("/proc/self/status"))
+print(int(status["VmHWM"].split()[0]) * 1024 if code == 0 else -1)
+"""  # VmHWM: the process's own high-water mark (a child's ru_maxrss counts its parent's at the fork)
+
+
 def peak_memory(source: Path, out: Path) -> int:
-    """Peak resident memory (bytes) of `attitude estimate source --out out` in a process of its own."""
-    command = [sys.executable, "-m", "attitude_fmu.systems.cli.commands", "estimate", str(source), "--out", str(out)]
-    process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    _, status, usage = os.wait4(process.pid, 0)
-    if status:
-        raise RuntimeError(f"{' '.join(command)} failed")
-    return usage.ru_maxrss * 1024  # Linux: kB
+    """Peak resident memory (bytes) of `attitude estimate source --out out` in a process of
+    its own (Linux: /proc/self/status)."""
+    run = subprocess.run([sys.executable, "-c", PEAK_SCRIPT, "estimate", str(source), "--out", str(out)],
+                         capture_output=True, text=True)
+    peak = int(run.stdout.split()[-1]) if run.returncode == 0 and run.stdout.split() else -1
+    if peak < 0:
+        raise RuntimeError(f"attitude estimate {source} failed: {run.stderr.strip()[-500:]}")
+    return peak
 
 
 def bench_io(n: int = 1_000_000, repeat: int = 3, progress: bool = True) -> dict:
