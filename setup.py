@@ -13,7 +13,12 @@ from setuptools.command.build_py import build_py
 
 
 class BuildWithKernels(build_py):
-    """build_py, then the kernels compiled from the built package's own files."""
+    """build_py (without this file, which sits in the package's folder), then the kernels
+    compiled from the built package's own files."""
+
+    def find_package_modules(self, package, package_dir):
+        return [m for m in super().find_package_modules(package, package_dir)
+                if not (package == "attitude_fmu" and m[1] == "setup")]
 
     def run(self):
         super().run()

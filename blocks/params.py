@@ -62,9 +62,9 @@ def _unit(p: Param) -> str:
 
 
 # plausible ranges shared by the parameters of one kind (Param's low and high, keyword arguments)
-TIME_S = {"low": 1e-3, "high": 1e6}  # s: time constants and durations, 1 ms to 11 days
+TIME_S = {"low": 1e-9, "high": 1e12}  # s: time constants and durations; 1 ns: at once, 1e12 s: never
 GRAVITY_M_S2 = {"low": 1.0, "high": 30.0}  # m/s²: gravity anywhere a body is measured (the moon's 1.6, Jupiter's 25)
-GYRO_NOISE = {"low": 1e-7, "high": 1.0}  # rad/s/√Hz: from a navigation-grade gyro's 2e-5 °/s/√Hz to 57 °/s/√Hz
+GYRO_NOISE = {"low": 1e-12, "high": 1.0}  # rad/s/√Hz: a simulation's noise-free gyro to 57 °/s/√Hz
 SLOSH = {"low": 1e-5, "high": 100.0}  # m/s/√Hz: the density of a motion's velocity, rest to violent shaking
 FREQUENCY_RAD_S = {"low": 1e-4, "high": 1e5}  # rad/s: break frequencies and band limits
 ANGLE_RAD = {"low": 1e-6, "high": math.pi}  # rad: tolerances and clips of angles

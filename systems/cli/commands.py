@@ -495,7 +495,7 @@ def cmd_bench(args) -> int:
     if args.samples < 1000 or args.repeat < 1:
         raise ValueError("--samples must be ≥ 1000 and --repeat ≥ 1")
     if args.io:
-        from attitude_fmu.systems.evaluation.bench_io import bench_io, print_io
+        from attitude_fmu.systems.cli.bench_io import bench_io, print_io
 
         result = bench_io(args.samples, repeat=min(args.repeat, 3))
         if args.json:
