@@ -73,10 +73,13 @@ def test_a_fresh_extraction_finds_the_kernels_another_extraction_compiled(fmu_di
     the second loads every kernel the first compiled and compiles none."""
     fmu = str(fmu_dir / "AttitudeEstimator.fmu")
     script = textwrap.dedent("""
-        import sys
-        sys.path.insert(0, sys.argv[1])
+        import sys, types
+        package = types.ModuleType("attitude_fmu")  # the extraction's copy, whatever else is installed
+        package.__path__ = [sys.argv[1] + "/attitude_fmu"]
+        sys.modules["attitude_fmu"] = package
         import numpy as np
         from attitude_fmu.blocks.quaternion import integrate_rates
+        assert integrate_rates.py_func.__code__.co_filename.startswith(sys.argv[1])
         quat = np.empty((5, 4))
         integrate_rates(np.full((5, 3), 0.1), 0.01, quat)
         print(quat[-1].tolist())
