@@ -1,7 +1,6 @@
 """Any per-sample step as a discrete-time python-control nonlinear I/O system."""
 from __future__ import annotations
 
-import control
 import numpy as np
 
 REMEMBERED = 16  # steps (state, input) remembered: an interconnect asks a block for several inputs per step
@@ -15,6 +14,7 @@ def sample_system(advance, inputs, outputs, states, dt: float, name: str, start=
     start(u) → the state to begin with at a first input u, used where x is all zeros
     (python-control's default initial state, no state a step can be in): the block then
     starts at rest on its first sample, as the batch path and the FMU do."""
+    import control
     remembered: dict[tuple[bytes, bytes], tuple[np.ndarray, np.ndarray]] = {}
 
     def step(x, u):

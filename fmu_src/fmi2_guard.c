@@ -10,7 +10,12 @@
  *   - a call during which the model logged a warning returns at least fmi2Warning, one that
  *     logged an error at least fmi2Error (the model logs, never raises: fmu_support.fail);
  *   - warnings and errors always reach the importer's logger; messages of status fmi2OK only
- *     with debug logging on, filtered by the categories of fmi2SetDebugLogging.
+ *     with debug logging on, filtered by the categories of fmi2SetDebugLogging;
+ *   - a call in a phase the standard does not allow it in (fmi2DoStep before initialisation
+ *     or after fmi2Terminate, ...), or on a value reference that is not of the call's type
+ *     (VARIABLE_TYPES in the resources), is refused with fmi2Error and a message, never
+ *     passed on to pythonfmu, which would end it in fmi2Fatal; after an fmi2Fatal only
+ *     fmi2FreeInstance is passed on.
  *
  * pythonfmu's library expects the host process to run Python (as fmpy or libcosimpy do).
  * In a host without it (most FMI tools), this library first loads the libpython the FMU
@@ -28,6 +33,7 @@
 
 #define PYTHONFMU_LIBRARY "pythonfmu-export.so"
 #define PYTHON_ENVIRONMENT "python_environment.txt" /* lines: libpython path, its soname, sys.path list */
+#define VARIABLE_TYPES "variable_types.txt"         /* one line: the type (R, I, B, S) of value reference 0, 1, ... */
 
 /* FMI 2.0 types (fmi2TypesPlatform.h, fmi2FunctionTypes.h) */
 typedef void *fmi2Component;
@@ -53,56 +59,72 @@ typedef struct {
 
 #define EXPORT __attribute__((visibility("default")))
 
-/* every entry point: return type, name, parameter list, argument list */
+/* FMI 2.0 co-simulation phases a call may come in (a bit each), and what a call needs */
+enum { INSTANTIATED = 1, INITIALIZATION = 2, STEPPING = 4, TERMINATED = 8, ANY = 15, SETTABLE = 7 };
+#define KEEP 0 /* the phase after a call: unchanged */
+
+/* every entry point: return type, name, parameter list, argument list, the phases it is
+ * allowed in, the phase it leads to when it succeeds (KEEP: none), the variable type its
+ * value references must have ('R', 'I', 'B', 'S'; 0: none) */
 #define FMI2_CALLS(X)                                                                                              \
     X(fmi2Status, fmi2SetupExperiment, (fmi2Component c, fmi2Boolean td, fmi2Real tol, fmi2Real t0, fmi2Boolean sd, \
-                                        fmi2Real t1), (c, td, tol, t0, sd, t1))                                     \
-    X(fmi2Status, fmi2EnterInitializationMode, (fmi2Component c), (c))                                             \
-    X(fmi2Status, fmi2ExitInitializationMode, (fmi2Component c), (c))                                              \
-    X(fmi2Status, fmi2Terminate, (fmi2Component c), (c))                                                           \
-    X(fmi2Status, fmi2Reset, (fmi2Component c), (c))                                                               \
-    X(fmi2Status, fmi2GetReal, (fmi2Component c, const fmi2ValueReference *vr, size_t n, fmi2Real *v), (c, vr, n, v)) \
+                                        fmi2Real t1), (c, td, tol, t0, sd, t1), INSTANTIATED, KEEP, NONE)              \
+    X(fmi2Status, fmi2EnterInitializationMode, (fmi2Component c), (c), INSTANTIATED, INITIALIZATION, NONE)            \
+    X(fmi2Status, fmi2ExitInitializationMode, (fmi2Component c), (c), INITIALIZATION, STEPPING, NONE)                 \
+    X(fmi2Status, fmi2Terminate, (fmi2Component c), (c), INITIALIZATION | STEPPING, TERMINATED, NONE)                 \
+    X(fmi2Status, fmi2Reset, (fmi2Component c), (c), ANY, INSTANTIATED, NONE)                                         \
+    X(fmi2Status, fmi2GetReal, (fmi2Component c, const fmi2ValueReference *vr, size_t n, fmi2Real *v), (c, vr, n, v), \
+      ANY, KEEP, TYPED('R'))                                                                                              \
     X(fmi2Status, fmi2GetInteger, (fmi2Component c, const fmi2ValueReference *vr, size_t n, fmi2Integer *v),        \
-      (c, vr, n, v))                                                                                               \
+      (c, vr, n, v), ANY, KEEP, TYPED('I'))                                                                               \
     X(fmi2Status, fmi2GetBoolean, (fmi2Component c, const fmi2ValueReference *vr, size_t n, fmi2Boolean *v),        \
-      (c, vr, n, v))                                                                                               \
+      (c, vr, n, v), ANY, KEEP, TYPED('B'))                                                                               \
     X(fmi2Status, fmi2GetString, (fmi2Component c, const fmi2ValueReference *vr, size_t n, fmi2String *v),          \
-      (c, vr, n, v))                                                                                               \
+      (c, vr, n, v), ANY, KEEP, TYPED('S'))                                                                               \
     X(fmi2Status, fmi2SetReal, (fmi2Component c, const fmi2ValueReference *vr, size_t n, const fmi2Real *v),        \
-      (c, vr, n, v))                                                                                               \
+      (c, vr, n, v), SETTABLE, KEEP, TYPED('R'))                                                                          \
     X(fmi2Status, fmi2SetInteger, (fmi2Component c, const fmi2ValueReference *vr, size_t n, const fmi2Integer *v),  \
-      (c, vr, n, v))                                                                                               \
+      (c, vr, n, v), SETTABLE, KEEP, TYPED('I'))                                                                          \
     X(fmi2Status, fmi2SetBoolean, (fmi2Component c, const fmi2ValueReference *vr, size_t n, const fmi2Boolean *v),  \
-      (c, vr, n, v))                                                                                               \
+      (c, vr, n, v), SETTABLE, KEEP, TYPED('B'))                                                                          \
     X(fmi2Status, fmi2SetString, (fmi2Component c, const fmi2ValueReference *vr, size_t n, const fmi2String *v),    \
-      (c, vr, n, v))                                                                                               \
-    X(fmi2Status, fmi2GetFMUstate, (fmi2Component c, fmi2FMUstate *s), (c, s))                                     \
-    X(fmi2Status, fmi2SetFMUstate, (fmi2Component c, fmi2FMUstate s), (c, s))                                      \
-    X(fmi2Status, fmi2FreeFMUstate, (fmi2Component c, fmi2FMUstate *s), (c, s))                                    \
-    X(fmi2Status, fmi2SerializedFMUstateSize, (fmi2Component c, fmi2FMUstate s, size_t *n), (c, s, n))             \
-    X(fmi2Status, fmi2SerializeFMUstate, (fmi2Component c, fmi2FMUstate s, fmi2Byte *b, size_t n), (c, s, b, n))   \
+      (c, vr, n, v), SETTABLE, KEEP, TYPED('S'))                                                                          \
+    X(fmi2Status, fmi2GetFMUstate, (fmi2Component c, fmi2FMUstate *s), (c, s), ANY, KEEP, NONE)                       \
+    X(fmi2Status, fmi2SetFMUstate, (fmi2Component c, fmi2FMUstate s), (c, s), ANY, KEEP, NONE)                        \
+    X(fmi2Status, fmi2FreeFMUstate, (fmi2Component c, fmi2FMUstate *s), (c, s), ANY, KEEP, NONE)                      \
+    X(fmi2Status, fmi2SerializedFMUstateSize, (fmi2Component c, fmi2FMUstate s, size_t *n), (c, s, n), ANY, KEEP, NONE) \
+    X(fmi2Status, fmi2SerializeFMUstate, (fmi2Component c, fmi2FMUstate s, fmi2Byte *b, size_t n), (c, s, b, n),   \
+      ANY, KEEP, NONE)                                                                                                \
     X(fmi2Status, fmi2DeSerializeFMUstate, (fmi2Component c, const fmi2Byte *b, size_t n, fmi2FMUstate *s),         \
-      (c, b, n, s))                                                                                                \
+      (c, b, n, s), ANY, KEEP, NONE)                                                                                  \
     X(fmi2Status, fmi2GetDirectionalDerivative, (fmi2Component c, const fmi2ValueReference *u, size_t nu,           \
-      const fmi2ValueReference *z, size_t nz, const fmi2Real *du, fmi2Real *dz), (c, u, nu, z, nz, du, dz))       \
+      const fmi2ValueReference *z, size_t nz, const fmi2Real *du, fmi2Real *dz), (c, u, nu, z, nz, du, dz),       \
+      ANY, KEEP, NONE)                                                                                                \
     X(fmi2Status, fmi2SetRealInputDerivatives, (fmi2Component c, const fmi2ValueReference *vr, size_t n,            \
-      const fmi2Integer *order, const fmi2Real *v), (c, vr, n, order, v))                                          \
+      const fmi2Integer *order, const fmi2Real *v), (c, vr, n, order, v), INITIALIZATION | STEPPING, KEEP, NONE)      \
     X(fmi2Status, fmi2GetRealOutputDerivatives, (fmi2Component c, const fmi2ValueReference *vr, size_t n,           \
-      const fmi2Integer *order, fmi2Real *v), (c, vr, n, order, v))                                                \
-    X(fmi2Status, fmi2DoStep, (fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean keep), (c, t, h, keep))        \
-    X(fmi2Status, fmi2CancelStep, (fmi2Component c), (c))                                                          \
-    X(fmi2Status, fmi2GetStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Status *v), (c, k, v))              \
-    X(fmi2Status, fmi2GetRealStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Real *v), (c, k, v))            \
-    X(fmi2Status, fmi2GetIntegerStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Integer *v), (c, k, v))      \
-    X(fmi2Status, fmi2GetBooleanStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Boolean *v), (c, k, v))      \
-    X(fmi2Status, fmi2GetStringStatus, (fmi2Component c, const fmi2StatusKind k, fmi2String *v), (c, k, v))
+      const fmi2Integer *order, fmi2Real *v), (c, vr, n, order, v), STEPPING | TERMINATED, KEEP, NONE)                \
+    X(fmi2Status, fmi2DoStep, (fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean keep), (c, t, h, keep),        \
+      STEPPING, KEEP, NONE)                                                                                           \
+    X(fmi2Status, fmi2CancelStep, (fmi2Component c), (c), STEPPING, KEEP, NONE)                                       \
+    X(fmi2Status, fmi2GetStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Status *v), (c, k, v), ANY, KEEP, NONE) \
+    X(fmi2Status, fmi2GetRealStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Real *v), (c, k, v), ANY, KEEP,  \
+      NONE)                                                                                                           \
+    X(fmi2Status, fmi2GetIntegerStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Integer *v), (c, k, v), ANY,  \
+      KEEP, NONE)                                                                                                     \
+    X(fmi2Status, fmi2GetBooleanStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Boolean *v), (c, k, v), ANY,  \
+      KEEP, NONE)                                                                                                     \
+    X(fmi2Status, fmi2GetStringStatus, (fmi2Component c, const fmi2StatusKind k, fmi2String *v), (c, k, v), ANY,    \
+      KEEP, NONE)
+#define TYPED(letter) letter, vr, n /* the value references a call's type applies to */
+#define NONE 0, NULL, 0
 
 /* pythonfmu's entry points, loaded once */
 static struct {
     fmi2Component (*fmi2Instantiate)(fmi2String, fmi2Type, fmi2String, fmi2String, const fmi2CallbackFunctions *,
                                      fmi2Boolean, fmi2Boolean);
     void (*fmi2FreeInstance)(fmi2Component);
-#define MEMBER(ret, name, params, args) ret(*name) params;
+#define MEMBER(ret, name, params, args, phases, next, type) ret(*name) params;
     FMI2_CALLS(MEMBER)
 #undef MEMBER
 } inner;
@@ -163,18 +185,25 @@ static const char *start_python(const char *binaries, char *message, size_t size
     return NULL;
 }
 
-static void load_inner(void) {
-    static char path[4096], message[4352];
+/* the folder of this library (binaries/<platform>) into dir; 0 where it cannot be found */
+static int own_folder(char *dir, size_t size) {
     Dl_info self;
-    if (!dladdr((void *)&load_inner, &self) || !self.dli_fname) {
+    if (!dladdr((void *)&own_folder, &self) || !self.dli_fname) return 0;
+    const char *slash = strrchr(self.dli_fname, '/');
+    if (slash) snprintf(dir, size, "%.*s", (int)(slash - self.dli_fname), self.dli_fname);
+    else snprintf(dir, size, ".");
+    return 1;
+}
+
+static void load_inner(void) {
+    static char path[4096], message[8192];
+    char dir[4000];
+    if (!own_folder(dir, sizeof dir)) {
         load_error = "cannot locate the FMU's own library";
         return;
     }
-    const char *slash = strrchr(self.dli_fname, '/');
-    int dir = slash ? (int)(slash - self.dli_fname) : 0;
-    snprintf(path, sizeof path, "%.*s", dir, self.dli_fname);
-    if ((load_error = start_python(slash ? path : ".", message, sizeof message))) return;
-    snprintf(path, sizeof path, "%.*s%s" PYTHONFMU_LIBRARY, dir, self.dli_fname, slash ? "/" : "");
+    if ((load_error = start_python(dir, message, sizeof message))) return;
+    snprintf(path, sizeof path, "%s/" PYTHONFMU_LIBRARY, dir);
     /* never unloaded: pythonfmu finalises its embedded Python when its library goes */
     void *lib = dlopen(path, RTLD_NOW | RTLD_LOCAL | RTLD_NODELETE);
     if (!lib) {
@@ -188,7 +217,7 @@ static void load_inner(void) {
         load_error = message;                                                                                      \
         return;                                                                                                    \
     }
-#define LOAD_CALL(ret, name, params, args) LOAD(name)
+#define LOAD_CALL(ret, name, params, args, phases, next, type) LOAD(name)
     LOAD(fmi2Instantiate)
     LOAD(fmi2FreeInstance)
     FMI2_CALLS(LOAD_CALL)
@@ -205,7 +234,55 @@ typedef struct {
     int debug;                     /* debug logging on (fmi2Instantiate / fmi2SetDebugLogging) */
     size_t n_categories;           /* 0: every category */
     char **categories;
+    int phase;                     /* INSTANTIATED, INITIALIZATION, STEPPING or TERMINATED */
+    int fatal;                     /* pythonfmu answered fmi2Fatal: only fmi2FreeInstance is passed on */
+    char *name;                    /* the instance's name, for messages */
+    char *types;                   /* VARIABLE_TYPES: the type of each value reference (NULL: unchecked) */
+    size_t n_types;
 } Guard;
+
+/* the FMU's VARIABLE_TYPES into g (none: value references are not checked) */
+static void read_types(Guard *g) {
+    char dir[4000], file[4200];
+    if (!own_folder(dir, sizeof dir)) return;
+    snprintf(file, sizeof file, "%s/../../resources/" VARIABLE_TYPES, dir);
+    FILE *f = fopen(file, "r");
+    if (!f) return;
+    size_t size = 256, n = 0;
+    char *types = malloc(size);
+    int ch;
+    while (types && (ch = fgetc(f)) != EOF && ch != '\n') {
+        if (n == size) {
+            char *more = realloc(types, size *= 2);
+            if (!more) free(types);
+            types = more;
+            if (!types) break;
+        }
+        types[n++] = (char)ch;
+    }
+    fclose(f);
+    g->types = types;
+    g->n_types = types ? n : 0;
+}
+
+static const char *type_name(char letter) {
+    switch (letter) {
+    case 'R': return "a Real";
+    case 'I': return "an Integer";
+    case 'B': return "a Boolean";
+    case 'S': return "a String";
+    default: return "none";
+    }
+}
+
+static const char *phase_text(int phase) {
+    switch (phase) {
+    case INSTANTIATED: return "before initialisation (fmi2EnterInitializationMode)";
+    case INITIALIZATION: return "in initialisation mode";
+    case STEPPING: return "after initialisation";
+    default: return "after fmi2Terminate (fmi2Reset starts the instance again)";
+    }
+}
 
 static int wanted(const Guard *g, fmi2String category) {
     if (!g->debug) return 0;
@@ -250,6 +327,36 @@ static void set_categories(Guard *g, size_t n, const fmi2String *categories) {
     for (size_t i = 0; i < g->n_categories; i++) g->categories[i] = strdup(categories[i] ? categories[i] : "");
 }
 
+/* fmi2OK if call may go on to pythonfmu in g's phase with value references vr[0..n) of the
+ * type letter (0: no check), else the status it ends with, its reason logged */
+static fmi2Status admit(Guard *g, const char *call, int phases, char letter, const fmi2ValueReference *vr, size_t n) {
+    char text[512];
+    fmi2Status status = fmi2Error;
+    if (g->fatal) {
+        snprintf(text, sizeof text, "%s refused: the instance ended in fmi2Fatal; only fmi2FreeInstance remains", call);
+        status = fmi2Fatal;
+    } else if (!(phases & g->phase)) {
+        snprintf(text, sizeof text, "%s refused: not allowed %s (FMI 2.0 co-simulation)", call, phase_text(g->phase));
+    } else if (letter && n && !vr) {
+        snprintf(text, sizeof text, "%s refused: no value references for %zu values", call, n);
+    } else {
+        for (size_t i = 0; letter && g->types && i < n; i++) {
+            char type = vr[i] < g->n_types ? g->types[vr[i]] : 0;
+            if (type != letter) {
+                if (type) snprintf(text, sizeof text, "%s refused: value reference %u is %s variable, not %s", call,
+                                   vr[i], type_name(type), type_name(letter));
+                else snprintf(text, sizeof text, "%s refused: value reference %u names no variable", call, vr[i]);
+                goto refused;
+            }
+        }
+        return fmi2OK;
+    }
+refused:
+    if (g->user.logger) deliver(&g->user, g->name, status, status == fmi2Fatal ? "logStatusFatal" : "logStatusError",
+                                text);
+    return status;
+}
+
 EXPORT const char *fmi2GetTypesPlatform(void) { return "default"; }
 EXPORT const char *fmi2GetVersion(void) { return "2.0"; }
 
@@ -268,9 +375,14 @@ EXPORT fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, 
     g->relayed.logger = relay;
     g->relayed.componentEnvironment = g;
     g->debug = loggingOn;
+    g->phase = INSTANTIATED;
+    g->name = strdup(instanceName ? instanceName : "");
+    read_types(g);
     /* pythonfmu drops every message without debug logging: it always gets it, relay() filters */
     g->model = inner.fmi2Instantiate(instanceName, fmuType, guid, resources, &g->relayed, visible, 1);
     if (!g->model) {
+        free(g->types);
+        free(g->name);
         free(g);
         return NULL;
     }
@@ -282,6 +394,8 @@ EXPORT void fmi2FreeInstance(fmi2Component c) {
     if (!g) return;
     inner.fmi2FreeInstance(g->model);
     set_categories(g, 0, NULL);
+    free(g->types);
+    free(g->name);
     free(g);
 }
 
@@ -292,13 +406,19 @@ EXPORT fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, si
     return fmi2OK;
 }
 
-#define FORWARD(ret, name, params, args)                                                                           \
+#define FORWARD(ret, name, params, args, phases, next, type)                                                     \
     EXPORT ret name params {                                                                                       \
         Guard *g = c;                                                                                              \
+        if (!g) return fmi2Error;                                                                                  \
+        fmi2Status refused = admit(g, #name, phases, type);                                                        \
+        if (refused != fmi2OK) return refused;                                                                     \
         g->logged = fmi2OK;                                                                                        \
         c = g->model;                                                                                              \
         fmi2Status status = inner.name args;                                                                       \
-        return status > g->logged ? status : g->logged;                                                            \
+        if (status < g->logged) status = g->logged;                                                                \
+        if (status == fmi2Fatal) g->fatal = 1;                                                                     \
+        else if (status <= fmi2Warning && next) g->phase = next;                                                   \
+        return status;                                                                                             \
     }
 FMI2_CALLS(FORWARD)
 #undef FORWARD

@@ -1,9 +1,12 @@
 /* fmi_host.c: a minimal FMI 2.0 co-simulation importer with no Python in its process, as
  * most FMI tools are (tests/test_fmu.py). Usage:
- *   fmi_host BINARY GUID RESOURCE_URI STEPS H VR_IN... -- U... -- VR_OUT...
+ *   fmi_host BINARY GUID RESOURCE_URI STEPS H VR_IN... -- U... -- VR_OUT... [-- VR_STRING]
  * sets the inputs VR_IN to U before each of STEPS doSteps of H seconds, then prints the
- * outputs VR_OUT, one per line. It ends with _exit: pythonfmu's library finalises its
- * interpreter from a destructor that can crash at process exit. */
+ * outputs VR_OUT, one per line. With VR_STRING (a String variable) it also makes the calls
+ * FMI 2.0 does not allow, fmi2SetReal on VR_STRING before initialisation and fmi2DoStep
+ * before it and after fmi2Terminate, and prints "misuse S1 S2 S3", their statuses, on
+ * standard error. It ends with _exit: pythonfmu's library finalises its interpreter from
+ * a destructor that can crash at process exit. */
 #include <dlfcn.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -21,6 +24,8 @@ typedef struct {
 } Callbacks;
 
 static void logger(void *env, const char *name, int status, const char *category, const char *message, ...) {
+    (void)env;
+    (void)name;
     va_list args;
     va_start(args, message);
     fprintf(stderr, "[%d %s] ", status, category);
@@ -54,19 +59,26 @@ int main(int argc, char **argv) {
     CALL(DoStep, fmi2DoStep);
     CALL(Mode, fmi2Terminate);
     CALL(Free, fmi2FreeInstance);
-    unsigned vr_in[64], vr_out[64];
+    unsigned vr_in[64], vr_out[64], vr_string = 0;
     double u[64], y[64];
-    size_t n_in = 0, n_u = 0, n_out = 0;
+    size_t n_in = 0, n_u = 0, n_out = 0, n_string = 0;
     int part = 0;
     for (int i = 6; i < argc; i++) {
         if (strcmp(argv[i], "--") == 0) part++;
         else if (part == 0 && n_in < 64) vr_in[n_in++] = (unsigned)atoi(argv[i]);
         else if (part == 1 && n_u < 64) u[n_u++] = atof(argv[i]);
         else if (part == 2 && n_out < 64) vr_out[n_out++] = (unsigned)atoi(argv[i]);
+        else if (part == 3 && n_string < 1) vr_string = (unsigned)atoi(argv[i]), n_string = 1;
     }
     Callbacks callbacks = {logger, calloc, free, NULL, NULL};
     Component c = fmi2Instantiate("host", 1, argv[2], argv[3], &callbacks, 0, 0);
     if (!c || n_u != n_in) return 4;
+    double one = 1.0;
+    int misuse[3] = {0, 0, 0};
+    if (n_string) {
+        misuse[0] = fmi2SetReal(c, &vr_string, 1, &one);
+        misuse[1] = fmi2DoStep(c, 0.0, atof(argv[5]), 1);
+    }
     int status = fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0) | fmi2EnterInitializationMode(c) |
                  fmi2ExitInitializationMode(c);
     int steps = atoi(argv[4]);
@@ -78,6 +90,10 @@ int main(int argc, char **argv) {
     status |= fmi2GetReal(c, vr_out, n_out, y);
     for (size_t i = 0; i < n_out; i++) printf("%.17g\n", y[i]);
     status |= fmi2Terminate(c);
+    if (n_string) {
+        misuse[2] = fmi2DoStep(c, steps * h, h, 1);
+        fprintf(stderr, "misuse %d %d %d\n", misuse[0], misuse[1], misuse[2]);
+    }
     fmi2FreeInstance(c);
     fflush(stdout);
     fflush(stderr);

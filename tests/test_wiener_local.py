@@ -163,3 +163,16 @@ def test_a_start_under_strong_acceleration_settles():
           f"after 300 s {settled:.3f}° (eq. 46: {optimum:.3f}°)")
     assert np.linalg.norm(acc[0]) > 30.0
     assert abs(settled / optimum - 1) < 0.15
+
+
+@pytest.mark.parametrize("omega_m, tau_v", [(10.0, 1.0), (1.0, 1.0), (0.2, 3.0), (300.0, 0.01)])
+def test_the_closed_form_slosh_integral_equals_its_quadrature(omega_m, tau_v):
+    """coefficients' 1/J: the integral of x⁴/((1 + x²)²·(1 + x²/c²)) over x ≥ 0 by
+    scipy's quad (the independent truth) against its closed form."""
+    from scipy.integrate import quad
+
+    c = omega_m * tau_v
+    J = quad(lambda x: x**4 / ((1.0 + x * x) ** 2 * (1.0 + (x / c) ** 2)), 0.0, np.inf, epsabs=0, epsrel=1e-13,
+             limit=200)[0] / (2.0 * math.pi * tau_v)
+    params = {**method("wiener").resolve(), "omega_m": omega_m, "tau_v": tau_v}
+    assert wiener_local.coefficients(params, 0.01)[4] == pytest.approx(1.0 / J, rel=1e-11)

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import math
 
-import control
 
 STANDARD_GRAVITY = 9.81  # m/s², the value the project uses for |g|
 
@@ -24,6 +23,7 @@ def omega_g(delta_n: float, delta_v: float, g: float = STANDARD_GRAVITY) -> floa
 
 def butterworth(omega_g: float) -> control.TransferFunction:
     """Eq. 34: the optimal filter for ω_c → ∞, ω_g²/(s² + √2·ω_g·s + ω_g²)."""
+    import control
     _require_positive(omega_g=omega_g)
     return control.tf([omega_g**2], [1.0, math.sqrt(2.0) * omega_g, omega_g**2])
 
@@ -41,6 +41,7 @@ def delta_phi(omega_g: float, omega_c: float) -> float:
 
 def wiener_band_limited(omega_g: float, omega_c: float) -> control.TransferFunction:
     """Eq. 33: the optimal filter for human motion band-limited at omega_c (rad/s)."""
+    import control
     dphi = delta_phi(omega_g, omega_c)
     damping = math.sqrt(2.0) * omega_g * (math.cos(dphi / 2) + math.sin(dphi / 2))
     return control.tf([omega_g**2 / omega_c, omega_g**2], [1.0, damping, omega_g**2])
@@ -48,6 +49,7 @@ def wiener_band_limited(omega_g: float, omega_c: float) -> control.TransferFunct
 
 def first_order(omega_f: float) -> control.TransferFunction:
     """Section 4.2: the filter optimal for white acceleration, ω_f/(s + ω_f)."""
+    import control
     _require_positive(omega_f=omega_f)
     return control.tf([omega_f], [1.0, omega_f])
 
@@ -64,6 +66,7 @@ def best_first_order_cutoff(omega_g: float, omega_c: float) -> float:
 
 def settle_time(earth_filter: control.TransferFunction) -> float:
     """Ten times the filter's slowest time constant, s: when a start transient has died out."""
+    import control
     return 10.0 / float(min(abs(p.real) for p in control.poles(earth_filter)))
 
 

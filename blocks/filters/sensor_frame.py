@@ -18,7 +18,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import control
 import numpy as np
 
 from attitude_fmu.blocks.control_system import sample_system
@@ -44,6 +43,7 @@ class DiscreteFilter:
 
     @classmethod
     def from_lti(cls, earth_filter, Ts: float) -> "DiscreteFilter":
+        import control
         if not (math.isfinite(Ts) and Ts > 0):
             raise ValueError(f"sample time Ts must be a finite positive number of seconds, got {Ts!r}")
         ss = _siso_state_space(earth_filter)
@@ -218,6 +218,7 @@ def initial_state(earth_filter, Ts: float, acc0) -> np.ndarray:
 
 
 def _continuous_system(ss, name):
+    import control
     A = np.asarray(ss.A, dtype=float)
     B = np.ravel(ss.B).astype(float)
     C = np.ravel(ss.C).astype(float)
@@ -239,6 +240,7 @@ def _continuous_system(ss, name):
 
 
 def _siso_state_space(earth_filter) -> control.StateSpace:
+    import control
     ss = control.ss(earth_filter)
     if ss.ninputs != 1 or ss.noutputs != 1:
         raise ValueError("the earth-frame filter must be single-input single-output (one axis)")

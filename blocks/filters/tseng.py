@@ -15,7 +15,6 @@ filter (gimbal-lock free).
 """
 from __future__ import annotations
 
-import control
 import numpy as np
 
 FAR_POLE = 1000.0  # rad/s: poles that make G_A proper for simulation, far above its zeros (10, 20 rad/s)
@@ -23,36 +22,43 @@ FAR_POLE = 1000.0  # rad/s: poles that make G_A proper for simulation, far above
 
 def accelerometer() -> control.TransferFunction:
     """Eq. 6: G_A = (0.1s + 1)(0.05s + 1), exact (improper)."""
+    import control
     return control.tf(np.polymul([0.1, 1.0], [0.05, 1.0]), [1.0])
 
 
 def accelerometer_model(far_pole: float = FAR_POLE) -> control.TransferFunction:
     """G_A with two poles at far_pole (rad/s), proper, for simulation."""
+    import control
     return accelerometer() * control.tf([far_pole**2], np.polymul([1.0, far_pole], [1.0, far_pole]))
 
 
 def magnetometer() -> control.TransferFunction:
     """Eq. 7: G_M = 50.265/(s + 50.265)."""
+    import control
     return control.tf([50.265], [1.0, 50.265])
 
 
 def gyroscope() -> control.TransferFunction:
     """Eq. 8: G_G = (s + 0.0185)/s, the integrated gyro's angle over the true angle."""
+    import control
     return control.tf([1.0, 0.0185], [1.0, 0.0])
 
 
 def lowpass_acc() -> control.TransferFunction:
     """Eq. 9: G_LA = 1/(0.063s³ + 0.475s² + 1.1937s + 1)."""
+    import control
     return control.tf([1.0], [0.063, 0.475, 1.1937, 1.0])
 
 
 def lowpass_mag() -> control.TransferFunction:
     """Eq. 10: G_LM = 1/(0.3979s + 1)."""
+    import control
     return control.tf([1.0], [0.3979, 1.0])
 
 
 def highpass_gyro() -> control.TransferFunction:
     """Eq. 11: G_H = s²/(s² + 0.6s + 0.09)."""
+    import control
     return control.tf([1.0, 0.0, 0.0], [1.0, 0.6, 0.09])
 
 
@@ -61,6 +67,7 @@ def chain(pair: str = "acc") -> control.TransferFunction:
 
     pair: "acc" (accelerometer and gyro) or "mag" (magnetometer and gyro).
     """
+    import control
     if pair == "acc":
         low = lowpass_acc() * accelerometer()
     elif pair == "mag":
@@ -72,16 +79,19 @@ def chain(pair: str = "acc") -> control.TransferFunction:
 
 def compensation(pair: str = "acc") -> control.TransferFunction:
     """The inverse of the pair's chain, C = 1/T."""
+    import control
     return control.minreal(1 / chain(pair), verbose=False)
 
 
 def compensated_chain(pair: str = "acc") -> control.TransferFunction:
     """Sensor models × filters × compensation: the complementary filter's response."""
+    import control
     return control.minreal(compensation(pair) * chain(pair), verbose=False)
 
 
 def earth_filter() -> control.TransferFunction:
     """The project's `tseng` filter in the gyro-estimated earth frame: C·G_LA."""
+    import control
     return control.minreal(compensation("acc") * lowpass_acc(), verbose=False)
 
 
@@ -111,6 +121,7 @@ def euler_complementary(gyr, acc, fs: float):
     method): roll and pitch from the accelerometer (eqs. 3–4) and from the gyro rates
     integrated through the Z-Y-X Euler kinematics (singular at pitch ±90°), combined as
     C·(G_LA·θ_acc + G_H·θ_gyro). Returns roll, pitch (rad) per sample."""
+    import control
     from attitude_fmu.blocks.filters.sensor_frame import DiscreteFilter
 
     gyr, acc = np.asarray(gyr, dtype=float), np.asarray(acc, dtype=float)

@@ -20,8 +20,23 @@ STATE_NAMES = ("q_w", "q_x", "q_y", "q_z", "b_x", "b_y", "b_z")  # q, gyro bias 
 
 
 def coefficients(params, Ts: float) -> np.ndarray:
-    """[k_P (1/s), k_I (1/s²), Ts (s), g (m/s²)]."""
+    """[k_P (1/s), k_I (1/s²), Ts (s), g (m/s²)]; gains unstable at Ts refused (check_gains)."""
+    check_gains(params["k_P"], params["k_I"], Ts)
     return np.array([params["k_P"], params["k_I"], Ts, params["g"]])
+
+
+def check_gains(k_P: float, k_I: float, Ts: float) -> None:
+    """Refuse gains k_P (1/s) and k_I (1/s²) with which the step diverges at the sample
+    time Ts (s). Linearised about the true attitude (tilt error x, bias error β, both per
+    axis), a step is β' = β + k_I·Ts·x, x' = (1 − k_P·Ts)·x − Ts·β', whose poles lie inside
+    the unit circle (Jury) for k_P·Ts < 2 and k_I·Ts² < 4 − 2·k_P·Ts."""
+    if k_P * Ts >= 2.0:
+        raise ValueError(f"parameter k_P = {k_P:g} 1/s is unstable at the sample time {Ts:g} s: Mahony's step "
+                         f"needs k_P·Ts < 2, k_P < {2.0 / Ts:g} 1/s at {1.0 / Ts:g} Hz")
+    if k_I * Ts * Ts >= 4.0 - 2.0 * k_P * Ts:
+        raise ValueError(f"parameter k_I = {k_I:g} 1/s² is unstable with k_P = {k_P:g} 1/s at the sample time "
+                         f"{Ts:g} s: Mahony's step needs k_I·Ts² < 4 − 2·k_P·Ts, k_I < "
+                         f"{(4.0 - 2.0 * k_P * Ts) / (Ts * Ts):g} 1/s² at {1.0 / Ts:g} Hz")
 
 
 def initial_state(coef, acc0) -> np.ndarray:

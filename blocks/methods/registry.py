@@ -13,14 +13,22 @@ from dataclasses import dataclass
 from functools import lru_cache
 from typing import Callable, Mapping
 
-import control
 import numpy as np
 
 from attitude_fmu.blocks.filters import earth_filters as ef
 from attitude_fmu.blocks.filters import tseng
 from attitude_fmu.blocks.filters.sensor_frame import DiscreteFilter, SensorFrameStepper, stepper_system
 from attitude_fmu.blocks.methods import luinge, mahony, tseng_adaptive, wiener_local
-from attitude_fmu.blocks.params import Param, resolve_params
+from attitude_fmu.blocks.params import (
+    ANGLE_RAD,
+    FREQUENCY_RAD_S,
+    GRAVITY_M_S2,
+    GYRO_NOISE,
+    SLOSH,
+    TIME_S,
+    Param,
+    resolve_params,
+)
 
 
 @dataclass(frozen=True)
@@ -57,25 +65,28 @@ class Method:
 
 NOMINAL_DELTA_V = 1.0  # m/s/√Hz: vigorous human motion (Rizun's Table 1), when delta_v is unset
 NOISE_PARAMS = (
-    Param("delta_n", math.radians(0.1), "rad/s/√Hz", "gyro noise density, one-sided (datasheet)"),
+    Param("delta_n", math.radians(0.1), "rad/s/√Hz", "gyro noise density, one-sided (datasheet)", **GYRO_NOISE),
     Param("delta_v", None, "m/s/√Hz",
-          f"slosh: density of the velocity of the motion (eq. 14); unset: {NOMINAL_DELTA_V:g} for the stationary filter"),
-    Param("g", ef.STANDARD_GRAVITY, "m/s²", "magnitude of gravity"),
+          f"slosh: density of the velocity of the motion (eq. 14); unset: {NOMINAL_DELTA_V:g} for the stationary filter",
+          **SLOSH),
+    Param("g", ef.STANDARD_GRAVITY, "m/s²", "magnitude of gravity", **GRAVITY_M_S2),
 )
 MAHONY_GAINS = (  # Mahony's filter, alone and in Tseng's adaptive switch
-    Param("k_P", 1.0, "1/s", "Mahony: proportional gain on the gravity-direction error"),
-    Param("k_I", 0.3, "1/s²", "Mahony: integral gain of the gyro-bias estimate; 0: no bias estimate", True),
+    Param("k_P", 1.0, "1/s", "Mahony: proportional gain on the gravity-direction error", low=1e-6, high=1e4),
+    Param("k_I", 0.3, "1/s²", "Mahony: integral gain of the gyro-bias estimate; 0: no bias estimate", True, high=1e4),
 )
 LOCAL_NOISE_PARAMS = (
     Param("stationary", 0.0, "1", "0: omega_g from noise densities measured over the last tau_noise s "
-          "(blocks.methods.wiener_local); 1, or omega_g, omega_c or delta_v given: the stationary filter", True),
+          "(blocks.methods.wiener_local); 1, or omega_g, omega_c or delta_v given: the stationary filter",
+          True, high=1.0, choices=(0.0, 1.0)),
     Param("scale_error", 0.005, "1", "rms of each element of the gyro's scale-factor and misalignment "
-          "error (datasheet)", True),
-    Param("omega_m", 10.0, "rad/s", "band limit of the motion (velocity and rate) in the local densities"),
-    Param("tau_noise", 1.0, "s", "averaging time of the local densities"),
+          "error (datasheet)", True, high=1.0),
+    Param("omega_m", 10.0, "rad/s", "band limit of the motion (velocity and rate) in the local densities",
+          **FREQUENCY_RAD_S),
+    Param("tau_noise", 1.0, "s", "averaging time of the local densities", **TIME_S),
     Param("tau_v", 1.0, "s", "time constant of the band-pass that turns the accelerometer into the "
-          "slosh velocity"),
-    Param("delta_v_min", 0.01, "m/s/√Hz", "floor of the local slosh density (rest)"),
+          "slosh velocity", **TIME_S),
+    Param("delta_v_min", 0.01, "m/s/√Hz", "floor of the local slosh density (rest)", **SLOSH),
 )
 
 
@@ -89,8 +100,6 @@ def _omega_g(p: Mapping[str, float | None]) -> float:
 
 
 def _wiener_is_local(p: Mapping[str, float | None]) -> bool:
-    if p["stationary"] not in (0.0, 1.0):
-        raise ValueError(f"parameter stationary must be 0 or 1, got {p['stationary']!r}")
     return p["stationary"] == 0.0 and p["omega_g"] is None and p["omega_c"] is None and p["delta_v"] is None
 
 
@@ -111,8 +120,10 @@ METHODS: dict[str, Method] = {
         "Rizun's optimal Wiener filter: eq. 34 (Butterworth) with omega_g from local noise densities; "
         "with stationary=1 eq. 34 at fixed densities, or eq. 33 when omega_c is given",
         NOISE_PARAMS + (
-            Param("omega_g", None, "rad/s", "break frequency; default sqrt(g·delta_n/delta_v), eq. 25"),
-            Param("omega_c", None, "rad/s", "band limit of the motion; given, eq. 33 replaces eq. 34"),
+            Param("omega_g", None, "rad/s", "break frequency; default sqrt(g·delta_n/delta_v), eq. 25",
+                  **FREQUENCY_RAD_S),
+            Param("omega_c", None, "rad/s", "band limit of the motion; given, eq. 33 replaces eq. 34",
+                  **FREQUENCY_RAD_S),
         ) + LOCAL_NOISE_PARAMS,
         _design_wiener,
         kernel=wiener_local,
@@ -128,9 +139,10 @@ METHODS: dict[str, Method] = {
         "tseng_adaptive",
         "Tseng's adaptive filter: complementary filter, Mahony's filter while |acc| leaves g by > tol",
         (
-            Param("tol", 0.5, "m/s²", "accelerometer norm's distance from g that switches to Mahony's filter"),
+            Param("tol", 0.5, "m/s²", "accelerometer norm's distance from g that switches to Mahony's filter",
+                  low=1e-4, high=400.0 * 9.80665),
             *MAHONY_GAINS,
-            Param("g", ef.STANDARD_GRAVITY, "m/s²", "magnitude of gravity"),
+            Param("g", ef.STANDARD_GRAVITY, "m/s²", "magnitude of gravity", **GRAVITY_M_S2),
         ),
         kernel=tseng_adaptive,
     ),
@@ -138,9 +150,11 @@ METHODS: dict[str, Method] = {
         "luinge",
         "Luinge's tilt Kalman filter: gyro orientation, 2-state KF on the tilt difference",
         (
-            Param("delta_n", math.radians(0.1), "rad/s/√Hz", "gyro noise density (process noise of the tilt)"),
-            Param("tilt_sd", 0.05, "rad", "s.d. of the accelerometer's tilt (acceleration as noise)"),
-            Param("g", ef.STANDARD_GRAVITY, "m/s²", "magnitude of gravity (scales the gravity output)"),
+            Param("delta_n", math.radians(0.1), "rad/s/√Hz", "gyro noise density (process noise of the tilt)",
+                  **GYRO_NOISE),
+            Param("tilt_sd", 0.05, "rad", "s.d. of the accelerometer's tilt (acceleration as noise)", **ANGLE_RAD),
+            Param("g", ef.STANDARD_GRAVITY, "m/s²", "magnitude of gravity (scales the gravity output)",
+                  **GRAVITY_M_S2),
         ),
         kernel=luinge,
     ),
@@ -148,7 +162,8 @@ METHODS: dict[str, Method] = {
         "mahony",
         "Mahony's complementary filter on SO(3) with gyro-bias estimation (IEEE TAC 53, 2008)",
         MAHONY_GAINS + (
-            Param("g", ef.STANDARD_GRAVITY, "m/s²", "magnitude of gravity (scales the gravity output)"),
+            Param("g", ef.STANDARD_GRAVITY, "m/s²", "magnitude of gravity (scales the gravity output)",
+                  **GRAVITY_M_S2),
         ),
         kernel=mahony,
     ),
@@ -156,9 +171,10 @@ METHODS: dict[str, Method] = {
         "first_order",
         "Rizun §4.2: first-order low-pass in the gyro-estimated earth frame",
         NOISE_PARAMS + (
-            Param("omega_g", None, "rad/s", "Wiener break frequency the best cut-off derives from"),
-            Param("omega_c", 10.0, "rad/s", "band limit of the motion (for the best cut-off)"),
-            Param("omega_f", None, "rad/s", "cut-off; default (omega_g⁴/(2·omega_c))^(1/3), the best"),
+            Param("omega_g", None, "rad/s", "Wiener break frequency the best cut-off derives from", **FREQUENCY_RAD_S),
+            Param("omega_c", 10.0, "rad/s", "band limit of the motion (for the best cut-off)", **FREQUENCY_RAD_S),
+            Param("omega_f", None, "rad/s", "cut-off; default (omega_g⁴/(2·omega_c))^(1/3), the best",
+                  **FREQUENCY_RAD_S),
         ),
         _design_first_order,
     ),

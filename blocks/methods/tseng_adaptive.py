@@ -10,15 +10,18 @@ filter's state per unit of constant input.
 """
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 
 from attitude_fmu.blocks.filters import tseng
 from attitude_fmu.blocks.filters.sensor_frame import DiscreteFilter, sensor_frame_step
 from attitude_fmu.blocks.jit import kernel
-from attitude_fmu.blocks.methods.mahony import mahony_step
+from attitude_fmu.blocks.methods.mahony import check_gains, mahony_step
 
 
 def coefficients(params, Ts: float) -> np.ndarray:
+    check_gains(params["k_P"], params["k_I"], Ts)  # its Mahony mode's
     disc = DiscreteFilter.from_lti(tseng.earth_filter(), Ts)
     unit_rest = disc.rest_state([1.0, 0.0, 0.0])[:, 0]
     return np.concatenate([[disc.order, Ts, params["tol"], params["g"], params["k_P"], params["k_I"], disc.D],
@@ -57,10 +60,16 @@ def run(state, coef, gyr, acc, gravity, quat):
         quat[k, 0], quat[k, 1], quat[k, 2], quat[k, 3] = q[0], q[1], q[2], q[3]
 
 
+@lru_cache(maxsize=1)
 def _state_names():
     order = DiscreteFilter.from_lti(tseng.earth_filter(), 0.01).order
     return tuple(f"x{j}_{a}" for j in range(order) for a in "xyz") + (
         "q_w", "q_x", "q_y", "q_z", "b_x", "b_y", "b_z")
 
 
-STATE_NAMES = _state_names()
+def __getattr__(name: str):
+    """STATE_NAMES, made on first use: designing the filter imports python-control, which
+    the other methods' paths do without."""
+    if name == "STATE_NAMES":
+        return _state_names()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

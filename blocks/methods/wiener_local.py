@@ -30,7 +30,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.integrate import quad
 
 from attitude_fmu.blocks.filters.earth_filters import butterworth, omega_g
 from attitude_fmu.blocks.filters.sensor_frame import filter_rows, level_onto_gravity, turn_rows
@@ -53,10 +52,12 @@ SQRT2 = math.sqrt(2.0)
 
 def coefficients(params, Ts: float) -> np.ndarray:
     """[Ts, g, δn², k_w, 1/J, δv_min², a_avg, leak_v]: δn_eff² = δn² + k_w·⟨|ω|²⟩,
-    δv² = ⟨|v|²⟩/(3·J), a_avg = 1 − exp(−Ts/τ), leak_v = exp(−Ts/τ_v)."""
+    δv² = ⟨|v|²⟩/(3·J), a_avg = 1 − exp(−Ts/τ), leak_v = exp(−Ts/τ_v); J =
+    ∫₀^∞ x⁴/((1 + x²)²·(1 + x²/c²)) dx / (2π·τ_v) with c = ω_m·τ_v, which partial
+    fractions in x² give as c²·(2c + 1)/(8·τ_v·(c + 1)²)."""
     wm, tau_v = params["omega_m"], params["tau_v"]
     c = wm * tau_v
-    J = quad(lambda x: x**4 / ((1.0 + x * x) ** 2 * (1.0 + (x / c) ** 2)), 0.0, np.inf)[0] / (2.0 * math.pi * tau_v)
+    J = c * c * (2.0 * c + 1.0) / (8.0 * tau_v * (c + 1.0) ** 2)
     return np.array([
         Ts, params["g"], params["delta_n"] ** 2, 4.0 * params["scale_error"] ** 2 / wm, 1.0 / J,
         params["delta_v_min"] ** 2, 1.0 - math.exp(-Ts / params["tau_noise"]), math.exp(-Ts / tau_v),

@@ -104,7 +104,9 @@ def estimate(
     (blocks.pipeline.causal.split_params), defaults otherwise. The filter starts at rest
     on initial_gravity (m/s², sensor coordinates, before the first sample), by default the
     first accelerometer sample turned back by the first gyro sample
-    (blocks.filters.sensor_frame.start_gravity). gyro_offset (default on, as `attitude
+    (blocks.filters.sensor_frame.start_gravity); rows whose accelerometer is all zero
+    before the first that is not are waited over as OnlineEstimator waits, and hold the
+    estimate the stages start with there (held_before). gyro_offset (default on, as `attitude
     estimate` and the FMU): estimate the gyro offset at rest and while moving and remove it
     (blocks.stages.gyro_offset; the estimate is returned as `offset`). mag (N×3, µT; rows
     with a NaN are missing samples): heading from the magnetometer with a guard against
@@ -131,11 +133,25 @@ def estimate(
     gyr, acc = check_imu(gyr, acc, fs)
     mag = None if mag is None else check_mag(mag, len(gyr))
     step = at(pipeline, 1.0 / fs)
+    start = int(np.argmax(acc.any(axis=1)))  # as OnlineEstimator, the stages wait for an accelerometer sample
+    if not acc[start].any():
+        raise ValueError("acc is zero throughout: no gravity to start on")
+    if start:
+        gyr, acc, mag = gyr[start:], acc[start:], None if mag is None else mag[start:]
     if offline:
-        return smoothed(pipeline, step, gyr, acc, mag, initial_gravity)
+        return held_before(smoothed(pipeline, step, gyr, acc, mag, initial_gravity), start)
     rows = run(pipeline, step, State(), gyr, acc, mag, initial_gravity=initial_gravity)
-    return AttitudeEstimate(rows.gravity, rows.quat, rows.offset, rows.mag_accepted, rows.mag_offset, rows.mag_delay,
-                            _mag_delay_source(pipeline, offline=False))
+    return held_before(AttitudeEstimate(rows.gravity, rows.quat, rows.offset, rows.mag_accepted, rows.mag_offset,
+                                        rows.mag_delay, _mag_delay_source(pipeline, offline=False)), start)
+
+
+def held_before(est: AttitudeEstimate, start: int) -> AttitudeEstimate:
+    """est preceded by start rows that hold its first (the rows the stages waited over)."""
+    if start:
+        for name, values in vars(est).items():
+            if isinstance(values, np.ndarray):
+                setattr(est, name, np.concatenate([np.repeat(values[:1], start, axis=0), values]))
+    return est
 
 
 def _mag_delay_source(pipeline: Pipeline, offline: bool) -> str | None:

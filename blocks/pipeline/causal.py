@@ -95,7 +95,7 @@ def configure(method: str = "wiener", params: Mapping[str, float] | None = None,
     Every value is checked here, before any sample is taken."""
     m = get_method(method)
     own, offset_params, heading_params = split_params(method, params, gyro_offset, heading)
-    m.runs_kernel(m.resolve(own))  # refuses values out of range, and a stationary other than 0 or 1
+    m.runs_kernel(m.resolve(own))  # refuses values out of range (blocks.params.resolve_params)
     for stage, runs, overrides in ((offset_stage, gyro_offset, offset_params), (heading_stage, heading, heading_params)):
         if runs:
             stage.resolve(overrides)

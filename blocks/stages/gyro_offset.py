@@ -46,28 +46,33 @@ from attitude_fmu.blocks.control_system import sample_system
 from attitude_fmu.blocks.filters.sensor_frame import time_reversed
 from attitude_fmu.blocks.jit import kernel
 from attitude_fmu.blocks.methods.wiener_local import butterworth_zoh
-from attitude_fmu.blocks.params import Param, resolve_params
+from attitude_fmu.blocks.params import GYRO_NOISE, Param, RATE_RAD_S, TIME_S, resolve_params
 from attitude_fmu.blocks.quaternion import quat_matrix, quat_multiply, quat_normalized, rotvec_quat
 
 REST_NOISE_SIGMAS = 4.5  # the least rest_gyr in units of the gyro noise's per-axis s.d. through tau_short
 PARAMS = (
     Param("rest_gyr", math.radians(2.0), "rad/s",
           "largest deviation of the gyro (through tau_short) from its low-pass at rest; at least "
-          f"{REST_NOISE_SIGMAS:g} times delta_n's noise through tau_short"),
-    Param("rest_gyr_abs", math.radians(5.0), "rad/s", "largest low-passed gyro norm at rest (offset included)"),
+          f"{REST_NOISE_SIGMAS:g} times delta_n's noise through tau_short", **RATE_RAD_S),
+    Param("rest_gyr_abs", math.radians(5.0), "rad/s", "largest low-passed gyro norm at rest (offset included)",
+          **RATE_RAD_S),
     Param("rest_acc", 0.5, "m/s²",
-          "largest deviation of the accelerometer (through tau_short) from its low-pass at rest"),
-    Param("rest_time", 1.5, "s", "time the rest conditions must hold"),
-    Param("tau_lp", 0.5, "s", "time constant of the low-passes of the rest detection"),
+          "largest deviation of the accelerometer (through tau_short) from its low-pass at rest",
+          low=1e-4, high=400.0 * 9.80665),
+    Param("rest_time", 1.5, "s", "time the rest conditions must hold", **TIME_S),
+    Param("tau_lp", 0.5, "s", "time constant of the low-passes of the rest detection", **TIME_S),
     Param("tau_short", 0.02, "s", "time constant of the low-pass that takes white noise out of the samples the rest "
-          "detection compares with its low-passes (human motion lies below 8 Hz)"),
+          "detection compares with its low-passes (human motion lies below 8 Hz)", **TIME_S),
     Param("delta_n", math.radians(0.1), "rad/s/√Hz",
-          "gyro noise density, one-sided (datasheet): each sample's weight at rest"),
-    Param("tau_acc", 3.0, "s", "time constant of the accelerometer low-pass in the gyro frame (motion tracking)"),
-    Param("sigma_init", math.radians(0.5), "rad/s", "uncertainty of the offset before any rest (per axis)"),
-    Param("sigma_motion", math.radians(0.1), "rad/s", "uncertainty the tracking while moving settles on (per axis)"),
+          "gyro noise density, one-sided (datasheet): each sample's weight at rest", **GYRO_NOISE),
+    Param("tau_acc", 3.0, "s", "time constant of the accelerometer low-pass in the gyro frame (motion tracking)",
+          **TIME_S),
+    Param("sigma_init", math.radians(0.5), "rad/s", "uncertainty of the offset before any rest (per axis)",
+          **RATE_RAD_S),
+    Param("sigma_motion", math.radians(0.1), "rad/s", "uncertainty the tracking while moving settles on (per axis)",
+          **RATE_RAD_S),
     Param("tau_motion", 100.0, "s", "time in which the offset may drift by sigma_motion; 0: no tracking while moving",
-          allow_zero=True),
+          allow_zero=True, high=1e6),
 )
 STATE_NAMES = (
     "glp_x", "glp_y", "glp_z", "alp_x", "alp_y", "alp_z",  # low-passed gyro (rad/s) and accelerometer (m/s²)

@@ -46,15 +46,17 @@ import math
 import numpy as np
 
 from attitude_fmu.blocks.jit import kernel
-from attitude_fmu.blocks.params import Param
+from attitude_fmu.blocks.params import FRACTION, Param, TIME_S
 
 PARAMS = (
     Param("mag_cal_time", 60.0, "s", "time over which the hard-iron fit forgets its samples (0: no hard-iron estimate)",
-          True),
-    Param("mag_cal_spread", 0.1, "1", "least s.d. of the field across its smallest axis, relative to the fit's radius"),
-    Param("mag_cal_tol", 0.05, "1", "largest rms distance of the field from the fitted sphere, relative to its radius"),
+          True, high=1e6),
+    Param("mag_cal_spread", 0.1, "1", "least s.d. of the field across its smallest axis, relative to the fit's radius",
+          **FRACTION),
+    Param("mag_cal_tol", 0.05, "1", "largest rms distance of the field from the fitted sphere, relative to its radius",
+          **FRACTION),
     Param("mag_cal_recent", 2.0, "s", "time constant over which the latest field samples are held against the sphere "
-          "the window fits; when they leave it, the fit starts afresh"),
+          "the window fits; when they leave it, the fit starts afresh", **TIME_S),
 )
 EXPLAINED = 0.5  # the fit's residual must be below this share of the field's own
 STATE_NAMES = (

@@ -38,21 +38,26 @@ import numpy as np
 
 from attitude_fmu.blocks.control_system import sample_system
 from attitude_fmu.blocks.jit import kernel
-from attitude_fmu.blocks.params import Param, resolve_params
+from attitude_fmu.blocks.params import ANGLE_RAD, Param, TIME_S, resolve_params
 from attitude_fmu.blocks.quaternion import quat_multiply, quat_rotate, rotvec_quat
 from attitude_fmu.blocks.stages import hard_iron, mag_delay
 from attitude_fmu.blocks.stages.hard_iron import hard_iron_step, pull
 
 PARAMS = (
-    Param("tau_heading", 10.0, "s", "time constant of the pull towards the magnetometer heading"),
-    Param("mag_norm_tol", 0.1, "1", "largest relative deviation of the field norm from its reference"),
-    Param("mag_dip_tol", math.radians(5.0), "rad", "largest deviation of the dip angle from its reference"),
-    Param("tau_reference", 60.0, "s", "time constant of the reference norm and dip"),
-    Param("heading_clip", math.radians(10.0), "rad", "largest heading innovation one sample may use"),
-    Param("mag_new_time", 20.0, "s", "how long a field outside the reference's tolerance must stay steady to replace it"),
-    Param("mag_new_angle", math.radians(90.0), "rad", "how far the sensor must turn meanwhile (0: no turn)", True),
+    Param("tau_heading", 10.0, "s", "time constant of the pull towards the magnetometer heading", **TIME_S),
+    Param("mag_norm_tol", 0.1, "1", "largest relative deviation of the field norm from its reference",
+          low=1e-6, high=10.0),
+    Param("mag_dip_tol", math.radians(5.0), "rad", "largest deviation of the dip angle from its reference",
+          **ANGLE_RAD),
+    Param("tau_reference", 60.0, "s", "time constant of the reference norm and dip", **TIME_S),
+    Param("heading_clip", math.radians(10.0), "rad", "largest heading innovation one sample may use", **ANGLE_RAD),
+    Param("mag_new_time", 20.0, "s", "how long a field outside the reference's tolerance must stay steady to replace it",
+          **TIME_S),
+    Param("mag_new_angle", math.radians(90.0), "rad", "how far the sensor must turn meanwhile (0: no turn)",
+          True, high=math.pi),
     Param("mag_delay", None, "s", "delay of the magnetometer behind the gyro; unset: estimated online "
-          "(blocks.stages.mag_delay; offline, measured from the whole recording, blocks.stages.delays.mag_delay)", True),
+          "(blocks.stages.mag_delay; offline, measured from the whole recording, blocks.stages.delays.mag_delay)",
+          True, high=10.0),
 ) + hard_iron.PARAMS + mag_delay.PARAMS
 STATE_NAMES = (
     "psi_c", "ref_norm", "ref_dip", "seen", "cand_norm", "cand_dip", "cand_n", "cand_dot",

@@ -24,7 +24,7 @@ import math
 import numpy as np
 
 from attitude_fmu.blocks.jit import kernel
-from attitude_fmu.blocks.params import Param
+from attitude_fmu.blocks.params import Param, TIME_S
 
 MAG_SPAN_S = 0.25  # s: the field is compared with the gyro over about this long
 MAG_DELAY_REACH_S = 0.1  # s: the largest delay looked for
@@ -32,7 +32,8 @@ MAG_DELAY_SIGMAS = 3.0  # a delay is taken only this many standard errors or mor
 MAG_DELAY_MIN_S = 5.0  # s of accepted field samples in the sums before a delay is taken (a few samples fit any)
 
 PARAMS = (
-    Param("tau_mag_delay", 60.0, "s", "memory of the online estimate of the magnetometer's delay (mag_delay unset)"),
+    Param("tau_mag_delay", 60.0, "s", "memory of the online estimate of the magnetometer's delay (mag_delay unset)",
+          **TIME_S),
 )
 STATE_NAMES = (
     "m_x", "m_y", "m_z",  # the last field sample (sensor frame, hard iron removed)

@@ -6,6 +6,7 @@ import numpy as np
 
 from attitude_fmu.blocks.filters import tseng
 from attitude_fmu.blocks.methods.registry import method as get_method
+from attitude_fmu.systems.recordings.output import save_figure
 
 HZ = np.logspace(-3, 1.5, 600)  # 0.001 … 31.6 Hz
 
@@ -43,5 +44,5 @@ def plot(method: str, out) -> None:
     mag.legend(fontsize=8)
     for ax in (mag, phase):
         ax.grid(True, which="both", alpha=0.3)
-    fig.savefig(out, dpi=120)
+    save_figure(fig, out, dpi=120)
     plt.close(fig)

@@ -14,6 +14,7 @@ from attitude_fmu.blocks.methods.registry import METHODS
 from attitude_fmu.blocks.methods.registry import method as known_method
 from attitude_fmu.blocks.pipeline.causal import ESTIMATORS
 from attitude_fmu.blocks.stages.timing import ACC_SAMPLES, GYR_SAMPLES, check_latency
+from attitude_fmu.systems.recordings.output import STDIO, check_output, same_file
 from attitude_fmu.systems.recordings.reading import MAX_GAP_S
 from attitude_fmu.systems.recordings.recording import (
     ACC_UNITS,
@@ -25,6 +26,7 @@ from attitude_fmu.systems.recordings.recording import (
     REF_COLUMNS,
     T_UNITS,
 )
+from attitude_fmu.systems.recordings.writing import output_name
 
 EXIT_BAD_INPUT = 2
 EXIT_CHECK_FAILED = 1
@@ -80,7 +82,7 @@ def _method_help() -> str:
         lines.append(title)
         for p in params:
             default = "unset" if p.default is None else f"{p.default:g}"
-            lines.append(f"    {p.name} [{p.unit}] (default {default}): {p.doc}")
+            lines.append(f"    {p.name} [{p.unit}] (default {default}): {p.doc}; plausible {p.range_text()}")
     return "\n".join(lines)
 
 
@@ -297,11 +299,16 @@ def build_parser() -> argparse.ArgumentParser:
 
     bn = sub.add_parser("bench", help="samples per second of the batch estimator, vqf and ahrs Madgwick")
     bn.add_argument("--json", action="store_true")
-    bn.add_argument("--samples", type=int, default=100_000)
+    bn.add_argument("--samples", type=int, help="samples of the recording (default 100000; with --io 1000000)")
     bn.add_argument("--fmu", action="store_true",
                     help="per-step cost of AttitudeEstimator.fmu against a no-op FMU of the same interface, pythonfmu "
                          "and native, under fmpy; and of the native against the pythonfmu one in a C host")
-    bn.add_argument("--repeat", type=int, default=10, help="interleaved rounds; each method's best run counts (default 10)")
+    bn.add_argument("--io", action="store_true",
+                    help="attitude estimate end to end on a 9D recording at 1 kHz (--samples, default here 1000000), "
+                         "CSV to CSV and Parquet to Parquet, against pandas read_csv + vqf 9D + pandas to_csv; "
+                         "peak memory (needs pip install 'attitude-fmu[bench]')")
+    bn.add_argument("--repeat", type=int, default=10, help="interleaved rounds; each method's best run counts "
+                    "(default 10; with --io at most 3)")
     bn.add_argument("--workers", type=_workers, metavar="N",
                     help="instead: wall time of attitude evaluate on --recordings and of attitude table1 on a local "
                          "cluster of N worker processes against one process, start-up included, and their ratio")
@@ -312,21 +319,15 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _check_out(path, source=None, figure: bool = False) -> None:
-    """Refuse, before any work is done, an output file whose folder does not exist, that is
-    a folder, or that is the input file source (writing it would lose the recording); a
-    figure (figure=True) also in a format matplotlib cannot write."""
-    folder = Path(path).absolute().parent
-    if not folder.is_dir():
-        raise ValueError(f"cannot write {path}: there is no folder {folder}")
-    if Path(path).is_dir():
-        raise ValueError(f"cannot write {path}: it is a folder; give a file name")
-    if source is not None and Path(path).resolve() == Path(source).resolve():
-        raise ValueError(f"cannot write {path}: it is the input; choose another --out")
+    """Refuse, before any work is done, an output file that cannot be written or that is
+    the input file source (systems.recordings.output.check_output); a figure (figure=True)
+    also one in a format matplotlib cannot write."""
+    check_output(path, () if source is None else (source,))
     if figure:
         from matplotlib.figure import Figure
 
         formats = Figure().canvas.get_supported_filetypes()
-        if Path(path).suffix.lstrip(".").lower() not in formats:
+        if str(path) == STDIO or Path(path).suffix.lstrip(".").lower() not in formats:
             raise ValueError(f"cannot write {path}: a figure's file name ends in one of "
                              f"{', '.join('.' + f for f in sorted(formats))} (e.g. .png)")
 
@@ -334,14 +335,15 @@ def _check_out(path, source=None, figure: bool = False) -> None:
 def _estimate_outputs(inputs, out) -> list:
     """The output file of each input: out itself for one input, unless out is a folder; for
     several, out is a folder (made here if absent, its parent must exist). In a folder,
-    input NAME.ext gives out/NAME.csv. Refused before any work: two inputs of one name,
-    an output that is an input."""
+    input NAME.ext gives out/NAME.csv (NAME.parquet for a Parquet input). Refused before
+    any work: two inputs of one name, an output that is an input."""
     if len(inputs) == 1 and not Path(out).is_dir():
         _check_out(out, inputs[0])
         return [out]
     folder = Path(out)
-    if folder.exists() and not folder.is_dir():
-        raise ValueError(f"cannot write into {out}: with {len(inputs)} inputs --out is a folder, and it is a file")
+    if str(out) == STDIO or folder.exists() and not folder.is_dir():
+        raise ValueError(f"cannot write into {out}: with {len(inputs)} inputs --out is a folder, and it is "
+                         f"{'standard output' if str(out) == STDIO else 'a file'}")
     stems = [Path(path).stem for path in inputs]
     repeated = sorted({stem for stem in stems if stems.count(stem) > 1})
     if repeated:
@@ -349,12 +351,14 @@ def _estimate_outputs(inputs, out) -> list:
                          "each other; estimate them in separate runs")
     if not folder.is_dir():
         _check_out(folder)  # the folder to make: its parent must exist
-    outputs = [folder / f"{stem}.csv" for stem in stems]
+    outputs = [folder / output_name(path) for path in inputs]
     for path in outputs:
-        if any(path.resolve() == Path(source).resolve() for source in inputs):
+        if any(same_file(path, source) for source in inputs):
             raise ValueError(f"cannot write {path}: it is an input; choose another --out")
         if path.is_dir():
             raise ValueError(f"cannot write {path}: it is a folder")
+        if folder.is_dir():
+            check_output(path)
     folder.mkdir(exist_ok=True)
     return outputs
 
@@ -414,7 +418,7 @@ def _estimate_one(args, path, out, prefix: str) -> None:
             extra["mag_offset"], extra["mag_delay"] = result.mag_offset, result.mag_delay
     write_estimate(out, rec.t[rows], result.quat[rows], result.up[rows], euler=args.euler,
                    extra={name: values[rows] for name, values in extra.items()})
-    progress(f"wrote {out}")
+    progress(f"wrote {'standard output' if str(out) == STDIO else out}")
     if result.offset is not None:
         print(f"attitude: {prefix}gyro offset estimate at the end "
               f"({', '.join(f'{v:.3f}' for v in np.degrees(result.offset[-1]))}) °/s", file=sys.stderr)
@@ -624,6 +628,7 @@ def cmd_bode(args) -> int:
 def cmd_bench(args) -> int:
     from attitude_fmu.systems.evaluation.bench import bench
 
+    args.samples = args.samples or (1_000_000 if args.io else 100_000)
     if args.samples < 1000 or args.repeat < 1:
         raise ValueError("--samples must be ≥ 1000 and --repeat ≥ 1")
     if args.workers:
@@ -639,6 +644,15 @@ def cmd_bench(args) -> int:
                     print(f"{name:>8}, {r['jobs']} jobs: 1 process {r['serial_s']:.1f} s, {args.workers} workers "
                           f"{r['distributed_s']:.1f} s, ratio {r['ratio']:.2f}; results "
                           f"{'identical' if r['identical'] else 'DIFFER'}")
+        return 0
+    if args.io:
+        from attitude_fmu.systems.cli.bench_io import bench_io, print_io
+
+        result = bench_io(args.samples, repeat=min(args.repeat, 3))
+        if args.json:
+            print(json.dumps(result, indent=2))
+        else:
+            print_io(result)
         return 0
     if args.fmu:
         from attitude_fmu.systems.evaluation.bench import bench_fmu

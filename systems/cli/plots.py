@@ -14,6 +14,7 @@ from attitude_fmu.blocks.methods.registry import design_delta_v
 from attitude_fmu.blocks.methods.registry import method as get_method
 from attitude_fmu.blocks.pipeline.batch import check_options, estimate
 from attitude_fmu.blocks.pipeline.causal import split_params
+from attitude_fmu.systems.recordings.output import save_figure
 from attitude_fmu.systems.recordings.reading import read_recording
 from attitude_fmu.systems.recordings.recording import RecordingError, print_notes
 from attitude_fmu.systems.recordings.writing import euler_degrees
@@ -81,7 +82,7 @@ def plot_recording(path, out, method: str = "wiener", params=None, offline: bool
     for ax in (top, bottom):
         ax.grid(True, which="both", alpha=0.3)
     fig.tight_layout()
-    fig.savefig(out, dpi=110)
+    save_figure(fig, out, dpi=110)
     plt.close(fig)
     return rmse
 
@@ -114,7 +115,7 @@ def _plot_angles(plt, name, label, t, est, out) -> None:
         ax.grid(True, alpha=0.3)
         ax.legend(loc="upper right")
     fig.tight_layout()
-    fig.savefig(out, dpi=110)
+    save_figure(fig, out, dpi=110)
     plt.close(fig)
 
 

@@ -20,11 +20,11 @@ from attitude_fmu.systems.simulation.sensor_model import ImuModel
 BENCH_FS = 100.0  # Hz
 
 
-def bench_recording(n: int = 100_000, seed: int = 0, mag: bool = False):
-    """A human-motion recording of n samples (about 3.5 m/s² RMS acceleration per axis)
-    with a MEMS-grade gyro: (gyr, acc), and with mag a magnetometer (µT, 0.1 µT/√Hz) as
-    well: (gyr, acc, mag)."""
-    motion = HumanMotion(delta_v=0.1, omega_c=5.0).generate(n / BENCH_FS, BENCH_FS, seed)
+def bench_recording(n: int = 100_000, seed: int = 0, mag: bool = False, fs: float = BENCH_FS):
+    """A human-motion recording of n samples at fs (Hz; about 3.5 m/s² RMS acceleration per
+    axis) with a MEMS-grade gyro: (gyr, acc), and with mag a magnetometer (µT, 0.1 µT/√Hz)
+    as well: (gyr, acc, mag)."""
+    motion = HumanMotion(delta_v=0.1, omega_c=5.0).generate(n / fs, fs, seed)
     imu = ImuModel(delta_n=np.radians(0.01), mag_noise=0.1)
     gyr, acc = imu.apply(motion, seed + 1)
     return (gyr, acc, imu.apply_mag(motion, seed + 1)) if mag else (gyr, acc)

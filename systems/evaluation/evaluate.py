@@ -23,6 +23,13 @@ from attitude_fmu.systems.recordings.recording import Recording, print_notes
 METRICS = ("total_rmse_deg", "heading_rmse_deg", "inclination_rmse_deg")
 LATENCY_SEARCH_S = 0.1  # imu_latency looks this far either way
 LATENCY_SAMPLES = 200_000  # at most this many gyro samples, evenly spread, enter imu_latency's fit
+REFERENCE_ORDERS = {  # a reference stored otherwise, as its columns w,x,y,z read it, turned back
+    "stored x,y,z,w (scalar last)": lambda q: np.roll(q, 1, axis=1),
+    "the inverse, earth → sensor": lambda q: q * [1.0, -1.0, -1.0, -1.0],
+    "stored x,y,z,w and the inverse": lambda q: np.roll(q, 1, axis=1) * [1.0, -1.0, -1.0, -1.0],
+}
+REFERENCE_RATIO = 4.0  # how much better another order must fit the estimate to be noted
+REFERENCE_NOTE_DEG = 5.0  # nor is anything said below this inclination RMSE (deg) as the reference is read
 
 
 def errors_on_movement(quat, rec: Recording) -> dict:
@@ -32,6 +39,24 @@ def errors_on_movement(quat, rec: Recording) -> dict:
     ok = rec.evaluated()
     errors = quaternion_errors(quat[ok], rec.quat_ref[ok])
     return {name: math.degrees(float(np.sqrt(np.mean(e**2)))) for name, e in zip(METRICS, errors)}
+
+
+def reference_order_note(rec: Recording, quat) -> str | None:
+    """A note where the reference read in another order (REFERENCE_ORDERS) fits the
+    estimate quat (N×4) REFERENCE_RATIO times better in inclination RMSE over
+    Recording.evaluated than as read, and that is REFERENCE_NOTE_DEG or more."""
+    ok = rec.evaluated()
+    rmse = lambda ref: math.degrees(float(np.sqrt(np.mean(quaternion_errors(quat[ok], ref)[2] ** 2))))
+    given = rmse(rec.quat_ref[ok])
+    if given < REFERENCE_NOTE_DEG:
+        return None
+    fits = {label: rmse(turn(rec.quat_ref[ok])) for label, turn in REFERENCE_ORDERS.items()}
+    label = min(fits, key=fits.get)
+    if REFERENCE_RATIO * fits[label] >= given:
+        return None
+    return (f"{rec.name}: the reference fits the estimate far better read as {label} (inclination RMSE "
+            f"{fits[label]:.2f}° against {given:.2f}° as read, w,x,y,z sensor → earth): is it stored so? Give it "
+            "as w,x,y,z sensor → earth (a CSV's columns can be named so with --column ref_q_w=NAME ...)")
 
 
 def imu_latency(rec: Recording) -> float | None:
@@ -69,7 +94,9 @@ def evaluate_recording(rec: Recording, method: str = "wiener", params=None, offl
                        gyro_offset: bool = True, use_mag: bool = True, latency: float = 0.0,
                        peers: bool = True) -> dict:
     """{method label: {metric: value}} for one recording; with a magnetometer (and use_mag)
-    the method's heading comes from it, and vqf's 9D estimate is added as "vqf_9d".
+    the method's heading comes from it, and vqf's 9D estimate is added as "vqf_9d". A
+    reference that fits far better in another order is noted in rec.notes
+    (reference_order_note).
     latency (s): every estimate, the peers' too, is carried forward over the IMU's delay
     (blocks.stages.timing; the peers' with the raw gyro). peers=False: the method's alone."""
     rec.evaluated()  # refuses a recording without a usable reference before any work
@@ -85,6 +112,9 @@ def evaluate_recording(rec: Recording, method: str = "wiener", params=None, offl
             carry_forward_rows(quat, np.zeros_like(gyr), gyr, latency)
         return errors_on_movement(quat, rec)
 
+    note = reference_order_note(rec, est.quat)
+    if note:
+        rec.notes.append(note)
     if not peers:
         return {label: errors_on_movement(est.quat, rec)}
     import vqf as vqf_module  # peers: the test extra (or [peers])
@@ -141,10 +171,10 @@ def evaluate_file(path, setup: Setup, peers: bool = True) -> dict:
     "notes": [how it was read]}; peers=False: the method's errors alone ("table" holds
     the method's label only, imu_latency_s None), as a sweep needs them."""
     rec = read_prepared(path, setup)
-    notes = rec.notes + ([f"{rec.name}: no movement flag; errors over every sample with a reference"]
-                         if rec.movement is None else [])
     table = evaluate_recording(rec, setup.method, setup.params, setup.offline, setup.gyro_offset, setup.use_mag,
                                setup.latency, peers)
+    notes = rec.notes + ([f"{rec.name}: no movement flag; errors over every sample with a reference"]
+                         if rec.movement is None else [])
     return {"table": table, "imu_latency_s": imu_latency(rec) if peers else None, "notes": notes}
 
 

@@ -38,6 +38,7 @@ PACKAGE_DIR = Path(attitude_fmu.__file__).resolve().parent
 SOURCE_DIR = PACKAGE_DIR / "fmu_src"
 FINGERPRINT = "resources/attitude_fmu_sources.sha256"  # in the FMU: the sources it was built from
 PYTHON_ENVIRONMENT = "resources/python_environment.txt"  # in the FMU: see python_environment
+VARIABLE_TYPES = "resources/variable_types.txt"  # in the FMU: see variable_types
 
 
 def _module_file(module: str) -> Path | None:
@@ -111,6 +112,18 @@ def python_environment() -> str:
     return f"{library if library and library.is_file() else ''}\n{soname}\n{json.dumps(folders)}\n"
 
 
+def variable_types(model_description: bytes) -> str:
+    """What fmi2_guard.c checks value references against: one line with the type of value
+    reference 0, 1, ... (R Real, I Integer, B Boolean, S String; - none)."""
+    from xml.etree import ElementTree
+
+    types = {}
+    for variable in ElementTree.fromstring(model_description).iter("ScalarVariable"):
+        kind = next(child.tag for child in variable if child.tag in ("Real", "Integer", "Boolean", "String"))
+        types[int(variable.get("valueReference"))] = kind[0]
+    return "".join(types.get(vr, "-") for vr in range(max(types, default=-1) + 1)) + "\n"
+
+
 def built_from(fmu) -> str | None:
     """The source fingerprint stored in the FMU at its build; None if it has none."""
     try:
@@ -147,6 +160,7 @@ def build_fmus(out, names=FMU_NAMES, native=NATIVE_NAMES, fmi3_names=fmi3.FMI3_N
             with zipfile.ZipFile(path, "a", zipfile.ZIP_DEFLATED) as zf:
                 zf.writestr(FINGERPRINT, source_fingerprint(path.stem) + "\n")
                 zf.writestr(PYTHON_ENVIRONMENT, python_environment())
+                zf.writestr(VARIABLE_TYPES, variable_types(zf.read("modelDescription.xml")))
     return built + build_native_fmus(out / "native", native) + fmi3.build_fmi3_fmus(out / "native" / "fmi3", fmi3_names)
 
 

@@ -26,6 +26,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from attitude_fmu.blocks.quaternion import integrate_rates
+from attitude_fmu.systems.recordings.recording import GYR_UNITS
 
 AXES = "xyz"
 WINDOW_S = 2.0  # s over which a measured vector is averaged (in the gyro's frame) before comparing
@@ -34,6 +35,7 @@ MIN_TURN_RAD = 0.3  # windows turning less than this from one to the next tell t
 MIN_WINDOWS = 20  # fewer turning pairs of windows than this: no verdict
 MISMATCH_RATIO = 4.0  # how much better a map must fit to be named
 SIGNIFICANT = 0.01  # nor is a mismatch below this share of the vector's mean square (≈ 6° of direction: drift's)
+WINDOW_SAMPLES = 100  # at most about this many samples of a window, evenly spread, enter its means
 
 
 def parse_axes(text: str) -> np.ndarray:
@@ -61,11 +63,17 @@ MAPS = [np.diag(signs)[list(order)] for order in itertools.permutations(range(3)
 # vector as P does, so of each pair the one that changes fewer signs stands for both
 
 
-def _orientations(gyr, fs: float) -> Rotation:
-    """The frame after each gyro sample (rad/s, mean rates) in the frame before the first."""
+def _orientations(gyr, fs: float, step: int = 1) -> Rotation:
+    """The frame after each step-th gyro sample (rad/s, mean rates; integrated over every
+    sample) in the frame before the first."""
     quat = np.empty((len(gyr), 4))
     integrate_rates(np.ascontiguousarray(gyr, dtype=float), 1.0 / fs, quat)
-    return Rotation.from_quat(quat, scalar_first=True)
+    return Rotation.from_quat(quat[step - 1::step], scalar_first=True)
+
+
+def _step(fs: float) -> int:
+    """Every how many samples one enters the window means at fs (Hz): WINDOW_SAMPLES a window."""
+    return max(1, _window(fs) // WINDOW_SAMPLES)
 
 
 def _window(fs: float) -> int:
@@ -92,12 +100,14 @@ def _window_means(frames: Rotation, vectors, finite, window: int):
     return mean_frame, products
 
 
-def mismatches(frames: dict, vectors, fs: float, hard_iron: bool = False) -> dict | None:
-    """{(map index in MAPS, gyro reversed): mean-square mismatch} (units² of vectors) of
+def mismatches(frames: dict, vectors, fs: float, hard_iron: bool = False, maps=MAPS,
+               min_turn: float = MIN_TURN_RAD) -> dict | None:
+    """{(map index in maps, gyro reversed): mean-square mismatch} (units² of vectors) of
     every map of vectors (N×3; rows with a NaN are not used), in frames ({gyro reversed:
     the N frames _orientations integrates from the gyro, or from its negative}): the gyro
-    as it is and, unless hard_iron (the magnetometer: its offset is fitted per map),
-    reversed; None where fewer than MIN_WINDOWS pairs of windows turn enough."""
+    as it is and, where frames has it and unless hard_iron (the magnetometer: its offset is
+    fitted per map), reversed; None where fewer than MIN_WINDOWS pairs of windows turn by
+    min_turn (rad) or more."""
     window = _window(fs)
     blocks = len(vectors) // window
     if blocks < MIN_WINDOWS:
@@ -107,16 +117,16 @@ def mismatches(frames: dict, vectors, fs: float, hard_iron: bool = False) -> dic
     vectors = np.where(finite[:, None], vectors[:n], 0.0)
     sampled = finite.reshape(blocks, window).any(axis=1)
     scores = {}
-    for reversed_gyro in (False, True) if not hard_iron else (False,):
+    for reversed_gyro in (False, True) if not hard_iron and True in frames else (False,):
         turned = frames[reversed_gyro][:n]
         centres = turned[window // 2::window]
         turn = (centres[:-1].inv() * centres[1:]).magnitude()
-        pairs = np.flatnonzero((turn >= MIN_TURN_RAD) & sampled[:-1] & sampled[1:])
+        pairs = np.flatnonzero((turn >= min_turn) & sampled[:-1] & sampled[1:])
         if len(pairs) < MIN_WINDOWS:
             return None
         mean_frame, products = _window_means(turned, vectors, finite, window)
         lever = -(mean_frame[pairs + 1] - mean_frame[pairs])  # −Δ mean(Q)·h: the hard iron's part
-        for index, matrix in enumerate(MAPS):
+        for index, matrix in enumerate(maps):
             means = np.einsum("bkij,ij->bk", products, matrix)
             residual = means[pairs + 1] - means[pairs]
             if hard_iron:
@@ -151,14 +161,57 @@ def axes_note(name: str, what: str, flag: str, unit: str, scores: dict | None, m
     return f"{head}); with {flags} it is {best:.3g}: pass that if the file's axes are so{negative}"
 
 
-def axes_notes(name: str, gyr, acc, mag, fs: float) -> list[str]:
-    """The notes of axes_note on a recording's accelerometer and magnetometer (or None)."""
+def axes_notes(name: str, gyr, acc, mag, fs: float, gyr_unit: str = "rad/s") -> list[str]:
+    """The notes of axes_note on a recording's accelerometer and magnetometer (or None),
+    or, where the gyro read in another unit than gyr_unit makes them turn as it says,
+    gyro_unit_note's instead. The gyro is integrated over every sample, the windows'
+    means are taken over every _step(fs)-th."""
     if len(gyr) // _window(fs) < MIN_WINDOWS:  # too short for a verdict (mismatches): nothing integrated
         return []
-    frames = {False: _orientations(gyr, fs), True: _orientations(-gyr, fs)}  # one integration each, for both sensors
+    step = _step(fs)
+    frames = {False: _orientations(gyr, fs, step), True: _orientations(-gyr, fs, step)}  # for both sensors
+    acc, mag, fs_used = acc[step - 1::step], None if mag is None else mag[step - 1::step], fs / step
+    unit = gyro_unit_note(name, gyr, acc, mag, fs, gyr_unit, frames[False])
+    if unit:
+        return [unit]
     mean_square = lambda v: float(np.nanmean(np.sum(v**2, axis=1)))
-    notes = [axes_note(name, "the accelerometer", "--acc-axes", "m/s²", mismatches(frames, acc, fs), mean_square(acc))]
+    notes = [axes_note(name, "the accelerometer", "--acc-axes", "m/s²", mismatches(frames, acc, fs_used),
+                       mean_square(acc))]
     if mag is not None:
         notes.append(axes_note(name, "the magnetometer", "--mag-axes", "µT",
-                               mismatches(frames, mag, fs, hard_iron=True), mean_square(mag)))
+                               mismatches(frames, mag, fs_used, hard_iron=True), mean_square(mag)))
     return [note for note in notes if note]
+
+
+def gyro_unit_note(name: str, gyr, acc, mag, fs: float, gyr_unit: str, frames: Rotation) -> str | None:
+    """A note naming --gyr-unit where, with the gyro (at fs, Hz) read in another unit (a
+    factor of 57.3 or 1000 from gyr_unit; frames: those integrated from it as read, at
+    every _step(fs)-th sample, as acc and mag are taken), the
+    accelerometer and the magnetometer (if any) stay put in the gyro's frame
+    MISMATCH_RATIO times better than as read, on every pair of windows whether the gyro
+    says they turn or not (the unit that fits best); nothing where the mismatch as read is below SIGNIFICANT of the
+    accelerometer's mean square."""
+    sensors = [(acc, False)] + ([(mag, True)] if mag is not None else [])
+    step = _step(fs)
+    score = lambda turned, v, hard_iron: (mismatches({False: turned}, v, fs / step, hard_iron, MAPS[:1], 0.0)
+                                          or {}).get((0, False))
+    given = [score(frames, v, h) for v, h in sensors]
+    if given[0] is None or given[0] < SIGNIFICANT * float(np.nanmean(np.sum(acc**2, axis=1))):
+        return None
+    candidates = {}  # unit → (scale, fits)
+    for unit, factor in GYR_UNITS.items():
+        if unit != gyr_unit:
+            scale = factor / GYR_UNITS[gyr_unit]
+            turned = _orientations(gyr * scale, fs, step)
+            candidates[unit] = scale, [score(turned, v, h) for v, h in sensors]
+    fitting = {unit: (scale, fits) for unit, (scale, fits) in candidates.items()
+               if all(fit is not None and g is not None and MISMATCH_RATIO * fit < g for fit, g in zip(fits, given))}
+    if not fitting:
+        return None
+    unit = min(fitting, key=lambda u: fitting[u][1][0])
+    scale, fits = fitting[unit]
+    what = "the accelerometer and the magnetometer turn" if mag is not None else "the accelerometer turns"
+    return (f"{name}: {what} {scale:.4g} times {'more' if scale > 1 else 'less'} than the gyro read in "
+            f"{gyr_unit} says (mean-square change of the accelerometer's {WINDOW_S:g}-s means in the gyro's "
+            f"frame {given[0]:.3g} (m/s²)², read in {unit} {fits[0]:.3g}): is the gyro in {unit}? "
+            f"pass --gyr-unit {unit}")

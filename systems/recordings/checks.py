@@ -6,9 +6,10 @@ import math
 
 import numpy as np
 
-from attitude_fmu.blocks.pipeline.causal import MAX_GYR_RAD_S
+from attitude_fmu.blocks.pipeline.causal import MAX_ACC_M_S2, MAX_GYR_RAD_S
 from attitude_fmu.systems.recordings.recording import (
     ACC_UNITS,
+    G_N,
     GYR_UNITS,
     MAG_UNITS,
     T_UNITS,
@@ -21,6 +22,9 @@ EARTH_FIELD_RANGE_UT = (20.0, 70.0)  # the geomagnetic field's norm anywhere on 
 UNIT_TOLERANCE = 0.1  # largest departure of a reference quaternion's norm from 1 (rounded columns pass)
 SATURATION_S = 0.02  # s: a run this long at exactly a column's largest magnitude is the sensor's range
 SATURATION_LEAST = {"gyr": 2.0, "acc": 15.0}  # rad/s, m/s²: below every MEMS range (±125 °/s, ±2 g)
+SPIKES = (3, 0.001)  # at most this many samples beyond a sensor's range, or this share of them, are spikes
+NO_GRAVITY_M_S2 = 1.0  # an accelerometer norm below this shows no gravity (at rest one reads 9.81 m/s²)
+RANGES = "gyro ±4000 °/s, accelerometer ±400 g per axis"  # MAX_GYR_RAD_S, MAX_ACC_M_S2 as the notes say them
 
 
 def field_norm_note(rec: Recording) -> str | None:
@@ -60,33 +64,73 @@ def check_shapes(rec: Recording) -> None:
             raise RecordingError(f"{rec.name}: {name} must be N×3 with N ≥ 1, got {a.shape}{hint}")
 
 
-def fill_non_finite(rec: Recording, max_gap: float) -> None:
-    """Gyro and accelerometer values that are not finite (a logger's dropouts) in runs of
-    rows up to max_gap seconds, between finite rows, interpolated linearly in place, and
+def beyond_range(a, bound: float) -> np.ndarray:
+    """(N, bool) the rows of a (N×3) with a finite value beyond ±bound."""
+    with np.errstate(invalid="ignore"):
+        return (np.isfinite(a) & (np.abs(a) > bound)).any(axis=1)
+
+
+def fill_invalid(rec: Recording, max_gap: float) -> None:
+    """Gyro and accelerometer samples that are invalid, not finite (a logger's dropouts) or
+    beyond every IMU's range (MAX_GYR_RAD_S, MAX_ACC_M_S2 per axis: spikes), in runs of
+    rows up to max_gap seconds between valid rows, interpolated linearly in place, and
     noted; at the first or last row, or in a longer run, refused."""
-    bad_rows = ~(np.isfinite(rec.gyr).all(axis=1) & np.isfinite(rec.acc).all(axis=1))
+    beyond = beyond_range(rec.gyr, MAX_GYR_RAD_S) | beyond_range(rec.acc, MAX_ACC_M_S2)
+    bad_rows = ~(np.isfinite(rec.gyr).all(axis=1) & np.isfinite(rec.acc).all(axis=1)) | beyond
     if not bad_rows.any():
         return
+    what = {(False, True): "not finite", (True, False): f"beyond every IMU's range ({RANGES})",
+            (True, True): f"not finite or beyond every IMU's range ({RANGES})"}[
+        beyond.any(), (bad_rows & ~beyond).any()]
     rows = np.flatnonzero(bad_rows)
     starts = rows[np.concatenate([[True], np.diff(rows) > 1])]
     ends = rows[np.concatenate([np.diff(rows) > 1, [True]])]
     longest = int(np.argmax(ends - starts))
     if bad_rows[0] or bad_rows[-1]:
         edge = "first" if bad_rows[0] else "last"
-        raise RecordingError(f"{rec.name}: gyro or accelerometer values that are not finite in the {edge} row; "
-                             "cut the rows before the first or after the last finite one")
+        raise RecordingError(f"{rec.name}: gyro or accelerometer values that are {what} in the {edge} row; "
+                             f"cut the rows before the first or after the last valid one")
     if (ends[longest] - starts[longest] + 1) / rec.fs > max_gap:
-        raise RecordingError(f"{rec.name}: gyro or accelerometer values that are not finite in rows "
+        raise RecordingError(f"{rec.name}: gyro or accelerometer values that are {what} in rows "
                              f"{starts[longest] + 1}–{ends[longest] + 1}, longer than --max-gap {max_gap:g} s; "
                              "split the recording there or raise --max-gap")
     index = np.arange(len(bad_rows))
-    for a in (rec.gyr, rec.acc):
-        for c in range(3):
-            good = np.isfinite(a[:, c])
-            a[~good, c] = np.interp(index[~good], index[good], a[good, c])
-    rec.notes.append(f"{rec.name}: {len(rows)} rows with gyro or accelerometer values that are not finite, in "
+    for a, bound in ((rec.gyr, MAX_GYR_RAD_S), (rec.acc, MAX_ACC_M_S2)):
+        with np.errstate(invalid="ignore"):
+            good = np.abs(a) <= bound  # False where not finite
+        for c in range(3):  # each value that is invalid, the others of its row kept
+            bad = ~good[:, c]
+            a[bad, c] = np.interp(index[bad], index[~bad], a[~bad, c])
+    rec.notes.append(f"{rec.name}: {len(rows)} rows with gyro or accelerometer values that are {what}, in "
                      f"{len(starts)} run{'s' * (len(starts) > 1)} (the longest "
                      f"{(ends[longest] - starts[longest] + 1) / rec.fs:g} s), interpolated linearly")
+
+
+def hold_until_gravity(rec: Recording) -> None:
+    """Where the accelerometer shows no gravity at the start (norm below NO_GRAVITY_M_S2:
+    a sensor not yet powered, a logger's zeros), those rows are set to no sample (0), in
+    place, which the estimators wait over (blocks.pipeline.batch.estimate, as
+    OnlineEstimator): they start at rest on the first sample that shows gravity, never on
+    "no gravity" taken as down; a note says so. check_values refuses an accelerometer
+    without gravity throughout."""
+    shows = np.einsum("ij,ij->i", rec.acc, rec.acc) >= NO_GRAVITY_M_S2**2
+    first = int(np.argmax(shows))
+    if first == 0 or not shows[first]:
+        return
+    rec.acc[:first] = 0.0
+    rec.notes.append(f"{rec.name}: the accelerometer shows no gravity (norm below {NO_GRAVITY_M_S2:g} m/s²) in the "
+                     f"first {first} samples ({first / rec.fs:g} s): the estimate waits for sample {first + 1}, the "
+                     "first that shows it, and holds its start over them")
+
+
+def typical_peak(values) -> float:
+    """The largest of values (finite ones) once the few largest are set aside as spikes
+    (SPIKES): what the sensor reaches, not what one bad sample says."""
+    v = values[np.isfinite(values)]
+    k = max(SPIKES[0], int(SPIKES[1] * len(v)))
+    if len(v) <= k:
+        return float(v.max()) if len(v) else 0.0
+    return float(np.partition(v, len(v) - k - 1)[len(v) - k - 1])
 
 
 def saturation_notes(rec: Recording) -> list[str]:
@@ -116,12 +160,18 @@ def saturation_notes(rec: Recording) -> list[str]:
 
 
 def check_values(rec: Recording, gyr_unit: str, acc_unit: str) -> None:
-    """The gyro's peak and the accelerometer's median norm against what IMUs give: values
-    that another unit would make plausible are a unit mistake, refused with the flag that
-    fixes it; values no unit explains (a sensor shaken far harder than a person moves) are
-    noted, and read as they are."""
-    peak = float(np.max(np.abs(rec.gyr)))
-    norm = float(np.median(np.linalg.norm(rec.acc, axis=1)))
+    """The gyro's peak (typical_peak: a few spikes aside, they are invalid samples for
+    fill_invalid) and the accelerometer's median norm, over the finite rows, against what
+    IMUs give: values that another unit would make plausible are a unit mistake, refused
+    with the flag that fixes it; an accelerometer without gravity (median norm below
+    NO_GRAVITY_M_S2) is refused; other values no unit explains (a sensor shaken far harder
+    than a person moves) are noted, and read as they are."""
+    finite = np.isfinite(rec.gyr).all(axis=1) & np.isfinite(rec.acc).all(axis=1)
+    if not finite.any():
+        return  # fill_invalid refuses it
+    peak = typical_peak(np.abs(rec.gyr[finite]).max(axis=1))
+    with np.errstate(over="ignore"):  # a norm beyond the largest float is inf, as far from gravity
+        norm = float(np.median(np.linalg.norm(rec.acc[finite], axis=1)))
     for flag, units, given, value, plausible, what in (
         ("--gyr-unit", GYR_UNITS, gyr_unit, peak, lambda p: p <= MAX_GYR_RAD_S,
          f"gyro reaches {peak:.1f} rad/s read as {gyr_unit}, beyond any MEMS gyro"),
@@ -133,6 +183,10 @@ def check_values(rec: Recording, gyr_unit: str, acc_unit: str) -> None:
         other = other_unit(units, given, value, plausible)
         if other is not None:
             raise RecordingError(f"{rec.name}: {what}; looks like {other}: pass {flag} {other}")
+        if flag == "--acc-unit" and norm < NO_GRAVITY_M_S2:
+            raise RecordingError(f"{rec.name}: the accelerometer shows no gravity (median norm {norm:.3g} m/s²; at "
+                                 f"rest an IMU reads about {G_N:.2f} m/s² along up): are its columns the "
+                                 "accelerometer's, and is it in the unit given?")
         rec.notes.append(f"{rec.name}: {what}, and no other unit ({', '.join(units)}) explains it; read as it is")
     if rec.quat_ref is not None:
         norm = np.linalg.norm(rec.quat_ref, axis=1)

@@ -3,11 +3,11 @@ and gaps, axes; the checks of systems.recordings.checks."""
 from __future__ import annotations
 
 import csv
+import io
 import itertools
 import math
 import re
 import shlex
-import warnings
 from collections.abc import Mapping
 from dataclasses import replace
 from pathlib import Path
@@ -19,7 +19,8 @@ from attitude_fmu.systems.recordings.checks import (
     check_rate,
     check_shapes,
     check_values,
-    fill_non_finite,
+    fill_invalid,
+    hold_until_gravity,
     saturation_notes,
 )
 from attitude_fmu.systems.recordings.recording import (
@@ -31,11 +32,13 @@ from attitude_fmu.systems.recordings.recording import (
     MAG_UNITS,
     MAT_VARIABLES,
     MOVEMENT_COLUMN,
+    PARQUET_SUFFIX,
     REF_COLUMNS,
     T_UNITS,
     Recording,
     RecordingError,
 )
+from attitude_fmu.systems.recordings.tables import Source, csv_numbers, decimal_points, parquet_header, parquet_numbers
 
 DELIMITERS = (",", ";", "\t")  # the header's most frequent one; with ";" or a tab, "," is a decimal comma
 MAX_GAP_S = 1.0  # longest run of missing samples filled in by default (s)
@@ -57,10 +60,7 @@ def read_recording(path, fs: float | None = None, gyr_unit: str = "rad/s", acc_u
     (systems.recordings.axes.axes_notes). A CSV's time stamps may jitter and skip samples:
     runs of missing samples up to max_gap seconds are filled in (_fill_gaps), longer ones
     refused; so are runs of gyro or accelerometer values that are not finite
-    (fill_non_finite)."""
-    path = Path(path)
-    if not path.is_file():
-        raise RecordingError(f"{path}: no such file")
+    (fill_invalid), and samples beyond every IMU's range."""
     units = ((gyr_unit, GYR_UNITS), (acc_unit, ACC_UNITS), (mag_unit, MAG_UNITS), (t_unit, T_UNITS))
     if any(unit not in known for unit, known in units):
         raise RecordingError(f"units must be one of {', '.join(str(list(known)) for _, known in units)}")
@@ -71,7 +71,9 @@ def read_recording(path, fs: float | None = None, gyr_unit: str = "rad/s", acc_u
     maps = {name: parse_axes(text) for name, text in (("gyr", gyr_axes), ("acc", acc_axes), ("mag", mag_axes))
             if text is not None}
     columns = dict(columns or {})
-    mat = path.suffix.lower() == ".mat"
+    source = Source.of(path)
+    path = source.path
+    mat = source.suffix == ".mat"
     known = MAT_VARIABLES if mat else KNOWN_COLUMNS
     unknown = [name for name in columns if name not in known]
     if unknown:
@@ -80,38 +82,53 @@ def read_recording(path, fs: float | None = None, gyr_unit: str = "rad/s", acc_u
     shared = sorted({c for c in columns.values() if list(columns.values()).count(c) > 1})
     if shared:
         raise RecordingError(f"--column gives the file's column {', '.join(shared)} more than one name")
-    rec = _read_mat(path, fs, columns) if mat else _read_csv(path, fs, max_gap, T_UNITS[t_unit], columns)
+    if mat:
+        rec = _read_mat(source, fs, columns)
+    else:
+        try:
+            rec = _read_table(source, fs, max_gap, T_UNITS[t_unit], columns)
+        except UnicodeDecodeError as exc:
+            raise source.not_text(exc) from None
     if fs is not None and abs(rec.fs - fs) > 0.01 * fs:
-        raise RecordingError(f"{path}: --fs {fs:g} Hz disagrees with the recording's {rec.fs:g} Hz")
-    rec.gyr = rec.gyr * GYR_UNITS[gyr_unit]
-    rec.acc = rec.acc * ACC_UNITS[acc_unit]
+        raise RecordingError(f"{source.label}: --fs {fs:g} Hz disagrees with the recording's {rec.fs:g} Hz")
+    rec.gyr *= GYR_UNITS[gyr_unit]  # in place: the recording's arrays are its own
+    rec.acc *= ACC_UNITS[acc_unit]
     if rec.mag is not None and np.isnan(rec.mag).any(axis=1).all():
         rec.mag = None
         rec.notes.append(f"{rec.name}: the magnetometer has no sample (NaN throughout); heading from the gyro")
     if rec.mag is not None:
-        rec.mag = rec.mag * MAG_UNITS[mag_unit]
+        rec.mag *= MAG_UNITS[mag_unit]
     check_shapes(rec)
     check_rate(rec.name, rec.fs)
-    fill_non_finite(rec, max_gap)
     check_values(rec, gyr_unit, acc_unit)
+    fill_invalid(rec, max_gap)
+    hold_until_gravity(rec)
     rec.notes += saturation_notes(rec)
     for name, matrix in maps.items():
         if getattr(rec, name) is not None:
             setattr(rec, name, getattr(rec, name) @ matrix.T)
-    rec.notes += axes_notes(rec.name, rec.gyr, rec.acc, rec.mag, rec.fs)
+    rec.notes += axes_notes(rec.name, rec.gyr, rec.acc, rec.mag, rec.fs, gyr_unit)
     return rec
 
 
-def _read_csv(path: Path, fs: float | None, max_gap: float, t_scale: float, columns: dict) -> Recording:
-    with path.open(newline="", encoding="utf-8-sig") as fh:  # a spreadsheet's byte-order mark is not a name
-        first = fh.readline()
-        following = list(itertools.islice(fh, MAX_LABEL_ROWS + 1))
-    delimiter = max(DELIMITERS, key=first.count)
-    header = next(csv.reader([first], delimiter=delimiter), None)
-    if not header:
-        raise RecordingError(f"{path}: empty file; expected a header t,{','.join(IMU_COLUMNS)}")
-    header = [h.strip() for h in header]
-    header[0] = header[0].lstrip("#").strip()  # a header marked as a comment (numpy.savetxt's default)
+def _read_table(source: Source, fs: float | None, max_gap: float, t_scale: float, columns: dict) -> Recording:
+    """A CSV or (by its suffix) a Parquet file: header t,gyr_x..z,acc_x..z and the optional
+    columns, checked before the numbers are read."""
+    path, parquet = source.label, source.suffix == PARQUET_SUFFIX
+    labels = []
+    if parquet:
+        header = parquet_header(source)
+    else:
+        with source.text(newline="") as fh:
+            first = fh.readline()
+            following = list(itertools.islice(fh, MAX_LABEL_ROWS + 1))
+        delimiter = max(DELIMITERS, key=first.count)
+        header = next(csv.reader([first], delimiter=delimiter), None)
+        if not header:
+            raise RecordingError(f"{path}: empty file; expected a header t,{','.join(IMU_COLUMNS)}")
+        header = [h.strip() for h in header]
+        header[0] = header[0].lstrip("#").strip()  # a header marked as a comment (numpy.savetxt's default)
+        labels = _label_rows(following, delimiter)
     header = _renamed(path, header, columns)
     missing = [c for c in IMU_COLUMNS if c not in header]
     if missing:
@@ -124,24 +141,22 @@ def _read_csv(path: Path, fs: float | None, max_gap: float, t_scale: float, colu
                                  f"the header has only {','.join(given)}")
     if "t" not in header and fs is None:
         raise RecordingError(f"{path}: no 't' column; give the sample rate with --fs HZ{_column_hint(['t'], header)}")
-    labels = _label_rows(following, delimiter)
-    try:
-        with warnings.catch_warnings():  # no rows: said below, not as numpy's warning
-            warnings.simplefilter("ignore", UserWarning)
-            with path.open(encoding="utf-8-sig") as fh:
-                rows = fh if delimiter == "," else (_decimal_points(line, delimiter) for line in fh)
-                data = np.loadtxt(rows, delimiter=delimiter, skiprows=1 + len(labels), ndmin=2, dtype=float)
-    except ValueError:
-        raise RecordingError(f"{path}: {_first_bad_line(path, delimiter, header, 1 + len(labels))}") from None
-    if data.shape[0] == 0 or data.shape[1] != len(header):
+    if parquet:
+        data = parquet_numbers(source, header)
+    else:
+        skip = 1 + len(labels)
+        data = csv_numbers(source, delimiter, len(header), skip,
+                           lambda: _first_bad_line(source, delimiter, header, skip))
+    if len(data) == 0:
         raise RecordingError(f"{path}: expected {len(header)} columns of numbers and at least one row")
-    col = {name: data[:, i] for i, name in enumerate(header)}
-    columns = lambda names: np.column_stack([col[c] for c in names]) if all(c in col for c in names) else None
-    movement = col.get(MOVEMENT_COLUMN)
-    rec = Recording(path.stem, 0.0, columns(IMU_COLUMNS[:3]), columns(IMU_COLUMNS[3:]),
-                    None if "t" not in col else col["t"] * t_scale,
-                    columns(MAG_COLUMNS), columns(REF_COLUMNS),
+    index = {name: i for i, name in enumerate(header)}
+    stack = lambda names: data.stack([index[c] for c in names]) if all(c in index for c in names) else None
+    movement = data.column(index[MOVEMENT_COLUMN]) if MOVEMENT_COLUMN in index else None
+    rec = Recording(source.path.stem, 0.0, stack(IMU_COLUMNS[:3]), stack(IMU_COLUMNS[3:]),
+                    None if "t" not in index else data.column(index["t"]) * t_scale,
+                    stack(MAG_COLUMNS), stack(REF_COLUMNS),
                     None if movement is None else _flag(path, MOVEMENT_COLUMN, movement))
+    del data
     if labels:
         rec.notes.append(f"{rec.name}: {len(labels)} row{'s' * (len(labels) > 1)} after the header without a number "
                          f"skipped (units?): {' / '.join(labels)}")
@@ -150,7 +165,7 @@ def _read_csv(path: Path, fs: float | None, max_gap: float, t_scale: float, colu
         absent = [c for c in KNOWN_COLUMNS if c not in header]
         rec.notes.append(f"{rec.name}: columns not read: {', '.join(unknown)}{_column_hint(absent, unknown)}")
     if rec.t is None:
-        rec.fs, rec.t = float(fs), np.arange(1, data.shape[0] + 1) / fs
+        rec.fs, rec.t = float(fs), np.arange(1, len(rec.gyr) + 1) / fs
         return rec
     if not np.isfinite(rec.t).all():
         raise RecordingError(f"{path}: column t has non-finite values")
@@ -166,33 +181,28 @@ def _read_csv(path: Path, fs: float | None, max_gap: float, t_scale: float, colu
     return rec
 
 
-def _decimal_points(line: str, delimiter: str) -> str:
-    """line with its decimal commas as points, where the separator is not the comma."""
-    return line if delimiter == "," else line.replace(",", ".")
-
-
 def _label_rows(lines, delimiter: str) -> list[str]:
     """Of the lines right after the header, the first ones (at most MAX_LABEL_ROWS) in
     which no field is a number: a units row ("s,rad/s,…") or a second header line, as
     loggers write them."""
     labels = []
     for line in lines:
-        fields = _decimal_points(line, delimiter).strip().split(delimiter)
+        fields = decimal_points(line, delimiter).strip().split(delimiter)
         if not line.strip() or any(_is_number(f) for f in fields):
             break
         labels.append(line.strip())
     return labels if len(labels) <= MAX_LABEL_ROWS else []
 
 
-def _first_bad_line(path: Path, delimiter: str, header: list[str], skip: int) -> str:
+def _first_bad_line(source: Source, delimiter: str, header: list[str], skip: int) -> str:
     """Where the rows after the first `skip` lines stop being numbers under the header, said
     with the file's line number and the column's name."""
-    with path.open(encoding="utf-8-sig") as fh:
+    with source.text() as fh:
         for number, line in enumerate(fh, start=1):
             text = line.strip()
             if number <= skip or not text or text.startswith("#"):
                 continue
-            fields = _decimal_points(text, delimiter).split(delimiter)
+            fields = decimal_points(text, delimiter).split(delimiter)
             if len(fields) != len(header):
                 return f"line {number} has {len(fields)} fields, the header {len(header)}: {text[:80]!r}"
             for name, field in zip(header, fields):
@@ -209,7 +219,7 @@ def _is_number(text: str) -> bool:
     return True
 
 
-def _renamed(path: Path, header: list[str], columns: dict) -> list[str]:
+def _renamed(path, header: list[str], columns: dict) -> list[str]:
     """header with the names columns maps ({ours: the file's}) replaced by ours; a column
     of the file that has one of those names already is left unread. Names read twice are
     refused."""
@@ -233,7 +243,7 @@ def _column_hint(wanted, header) -> str:
     return f"; to read them pass {' '.join(flags)}" if flags else ""
 
 
-def _sample_grid(path: Path, t: np.ndarray, max_gap: float) -> tuple[np.ndarray, float, float]:
+def _sample_grid(path, t: np.ndarray, max_gap: float) -> tuple[np.ndarray, float, float]:
     """(index of each row on a uniform grid, its rate in Hz, largest distance of a time
     stamp from the grid in steps). Each time step counts as the whole number of median
     steps nearest to it, so jitter below half a step is tolerated and a longer step is a
@@ -295,7 +305,7 @@ def _fill_gaps(rec: Recording, index: np.ndarray) -> Recording:
                    filled=filled)
 
 
-def _flag(path: Path, name: str, values) -> np.ndarray:
+def _flag(path, name: str, values) -> np.ndarray:
     """A 0/1 column as booleans; anything else is refused."""
     values = np.asarray(values, dtype=float)
     bad = (values != 0) & (values != 1)
@@ -305,15 +315,17 @@ def _flag(path: Path, name: str, values) -> np.ndarray:
     return values == 1
 
 
-def _read_mat(path: Path, fs: float | None, columns: dict) -> Recording:
+def _read_mat(source: Source, fs: float | None, columns: dict) -> Recording:
     """A BROAD recording, its variables (MAT_VARIABLES) renamed from the file's by columns
     ({BROAD's name: the file's}); without a sampling_rate variable, at fs (Hz) if given."""
     from scipy.io import loadmat
 
+    path = source.label
+    file = source.path if source.data is None else io.BytesIO(source.data)
     try:
-        mat = loadmat(path, squeeze_me=True)
+        mat = loadmat(file, squeeze_me=True)
     except NotImplementedError:  # scipy's answer to a v7.3 file
-        mat = _read_mat_v73(path)
+        mat = _read_mat_v73(path, file)
     except Exception as exc:  # scipy raises several types for damaged files
         raise RecordingError(f"{path}: not a readable MATLAB file ({exc})") from None
     variables = ", ".join(k for k in mat if not k.startswith("__")) or "none"
@@ -331,14 +343,17 @@ def _read_mat(path: Path, fs: float | None, columns: dict) -> Recording:
         fs = float(mat["sampling_rate"]) if "sampling_rate" in mat else fs
     except (TypeError, ValueError):
         raise RecordingError(f"{path}: sampling_rate must be one number (Hz)") from None
-    gyr = np.atleast_2d(np.asarray(mat["imu_gyr"], dtype=float))
-    acc = np.atleast_2d(np.asarray(mat["imu_acc"], dtype=float))
+    check_rate(path, fs)
+    gyr, acc = (np.atleast_2d(_numbers(path, mat, key)) for key in ("imu_gyr", "imu_acc"))
     n = len(gyr)
+    if gyr.ndim == acc.ndim == 2 and gyr.shape[1] == acc.shape[1] == 3 and len(acc) != n:
+        raise RecordingError(f"{path}: imu_acc has {len(acc)} samples, imu_gyr {n}: expected one accelerometer "
+                             "sample per gyro sample (both N×3, at one rate)")
 
     def optional(key, width):
         if key not in mat:
             return None
-        value = np.asarray(mat[key], dtype=float)
+        value = _numbers(path, mat, key)
         if value.size != n * max(width, 1):
             raise RecordingError(f"{path}: {key} has {value.size} values, expected {n}"
                                  f"{f'×{width}' if width else ''} (one per sample of imu_gyr)")
@@ -346,18 +361,27 @@ def _read_mat(path: Path, fs: float | None, columns: dict) -> Recording:
 
     movement = optional("movement", 0)
     return Recording(
-        path.stem, fs, gyr, acc, np.arange(1, n + 1) / fs, optional("imu_mag", 3),
+        source.path.stem, fs, gyr, acc, np.arange(1, n + 1) / fs, optional("imu_mag", 3),
         optional("opt_quat", 4), None if movement is None else _flag(path, "movement", movement),
     )
 
 
-def _read_mat_v73(path: Path) -> dict:
-    """The numeric variables of a MATLAB v7.3 file (HDF5), as loadmat(squeeze_me=True)
+def _numbers(path: str, mat: dict, key: str) -> np.ndarray:
+    """The variable key of a MATLAB file as an array of floats, or an error saying what it holds."""
+    try:
+        return np.asarray(mat[key], dtype=float)
+    except (TypeError, ValueError):
+        raise RecordingError(f"{path}: {key} holds {type(mat[key]).__name__} "
+                             f"{getattr(mat[key], 'dtype', '')}, expected a numeric array") from None
+
+
+def _read_mat_v73(path: str, file) -> dict:
+    """The numeric variables of a MATLAB v7.3 file (HDF5) at file, as loadmat(squeeze_me=True)
     gives them from older versions: HDF5 holds MATLAB's arrays transposed."""
     import h5py
 
     try:
-        with h5py.File(path, "r") as f:
+        with h5py.File(file, "r") as f:
             return {name: np.squeeze(np.asarray(item).T) for name, item in f.items()
                     if isinstance(item, h5py.Dataset) and item.dtype.kind in "fiub"}
     except OSError as exc:

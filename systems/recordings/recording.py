@@ -18,6 +18,7 @@ G_N = 9.80665  # m/s², standard gravity: the unit g of accelerometers (not the 
 ACC_UNITS = {"m/s2": 1.0, "g": G_N, "mg": G_N / 1e3}
 MAG_UNITS = {"uT": 1.0, "nT": 1e-3, "G": 100.0, "mG": 0.1}  # to µT
 T_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}  # to s
+PARQUET_SUFFIX = ".parquet"  # a file name ending so is read and written as Parquet; .mat is MATLAB, any other CSV
 
 
 class RecordingError(ValueError):

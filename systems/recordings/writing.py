@@ -1,11 +1,18 @@
-"""Estimates out: the CSV writer and its columns."""
+"""Estimates out: the writer (CSV, or Parquet by the file name's suffix) and its columns."""
 from __future__ import annotations
+
+from pathlib import Path
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from attitude_fmu.systems.recordings.output import replaced
+from attitude_fmu.systems.recordings.recording import PARQUET_SUFFIX
+
 OUTPUT_COLUMNS = ("t", "q_w", "q_x", "q_y", "q_z", "g_x", "g_y", "g_z")
 EULER_COLUMNS = ("roll_deg", "pitch_deg", "yaw_deg")  # with --euler
+CSV_DIGITS = 10  # significant digits of the CSV's numbers (Parquet keeps every bit)
+ROWS_PER_BATCH = 1 << 16  # rows converted and written at a time: memory stays small whatever the length
 
 
 def euler_degrees(quat) -> np.ndarray:
@@ -14,15 +21,78 @@ def euler_degrees(quat) -> np.ndarray:
     return Rotation.from_quat(quat, scalar_first=True).as_euler("ZYX", degrees=True)[:, ::-1]
 
 
+def output_name(source) -> str:
+    """The name of the output of input source in an output folder: NAME.csv for NAME.csv
+    or NAME.mat, NAME.parquet for NAME.parquet."""
+    source = Path(source)
+    return source.stem + (PARQUET_SUFFIX if source.suffix.lower() == PARQUET_SUFFIX else ".csv")
+
+
+def significant(x, digits: int = CSV_DIGITS) -> np.ndarray:
+    """x rounded to `digits` significant digits, each value the double nearest to its
+    rounded decimal (so that the shortest text that reads it back, as the CSV writer
+    gives, has at most that many digits); zeros, non-finite values and magnitudes beyond
+    1e±(22 − digits) are left as they are."""
+    x = np.asarray(x, dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        k = digits - 1 - np.floor(np.log10(np.abs(x)))
+        exact = np.abs(k) <= 22  # False where k is not finite
+        power = _POWERS_OF_TEN[np.where(exact, np.abs(k), 0).astype(np.intp)]  # exact; IEEE × and ÷ round correctly
+        rounded = np.where(k >= 0, np.rint(x * power) / power, np.rint(x / power) * power)
+    return np.where(exact, rounded, x)
+
+
+_POWERS_OF_TEN = np.array([float(10 ** k) for k in range(23)])
+
+
+def _arrow(values: np.ndarray):
+    """A contiguous float64 numpy array as a pyarrow array on its memory (pyarrow's own
+    conversion imports pandas, a good part of a second at every start)."""
+    import pyarrow as pa
+
+    return pa.Array.from_buffers(pa.float64(), len(values), [None, pa.py_buffer(values)])
+
+
 def write_estimate(path, t, quat, up, euler: bool = False, extra=None) -> None:
-    """CSV with columns t,q_w,q_x,q_y,q_z,g_x,g_y,g_z (g the unit up-vector, sensor
-    coordinates); euler adds roll, pitch and yaw in degrees (EULER_COLUMNS, euler_degrees);
-    extra ({name: N×3 or N}) adds name_x,name_y,name_z, or the column name, after them."""
-    columns, table = OUTPUT_COLUMNS, [t, quat, up]
+    """Columns t,q_w,q_x,q_y,q_z,g_x,g_y,g_z (g the unit up-vector, sensor coordinates);
+    euler adds roll, pitch and yaw in degrees (EULER_COLUMNS, euler_degrees); extra
+    ({name: N×3 or N}) adds name_x,name_y,name_z, or the column name, after them. A path
+    ending in PARQUET_SUFFIX gets a Parquet file (float64, every bit), any other a CSV
+    (CSV_DIGITS significant digits); "-" the CSV on standard output. Written by
+    systems.recordings.output.replaced: complete, or not at all."""
+    import pyarrow as pa
+
+    blocks = [("t", np.asarray(t)[:, None]), (OUTPUT_COLUMNS[1:5], quat), (OUTPUT_COLUMNS[5:], up)]
     if euler:
-        columns = columns + EULER_COLUMNS
-        table.append(euler_degrees(quat))
+        blocks.append((EULER_COLUMNS, None))  # per batch, from quat
     for name, values in (extra or {}).items():
-        columns = columns + ((name,) if np.ndim(values) == 1 else tuple(f"{name}_{a}" for a in "xyz"))
-        table.append(values)
-    np.savetxt(path, np.column_stack(table), delimiter=",", header=",".join(columns), comments="", fmt="%.10g")
+        values = np.asarray(values)
+        blocks.append(((name,), values[:, None]) if values.ndim == 1 else (tuple(f"{name}_{a}" for a in "xyz"), values))
+    names = [n for columns, _ in blocks for n in ((columns,) if isinstance(columns, str) else columns)]
+    parquet = Path(str(path)).suffix.lower() == PARQUET_SUFFIX
+    schema = pa.schema([(n, pa.float64()) for n in names])
+
+    def batches():
+        for start in range(0, len(t), ROWS_PER_BATCH):
+            rows = slice(start, start + ROWS_PER_BATCH)
+            columns = []
+            for _, values in blocks:
+                values = euler_degrees(quat[rows]) if values is None else values[rows]
+                columns += [np.ascontiguousarray(c, dtype=float) for c in values.T]
+            yield pa.RecordBatch.from_arrays([_arrow(c if parquet else significant(c)) for c in columns], schema=schema)
+
+    with replaced(path) as fh:
+        if parquet:
+            import pyarrow.parquet as pq
+
+            with pq.ParquetWriter(fh, schema, use_dictionary=False) as writer:  # measurements do not repeat
+                for batch in batches():
+                    writer.write_batch(batch)
+            return
+        import pyarrow.csv as pc
+
+        fh.write((",".join(names) + "\n").encode())  # the header unquoted, as the columns are
+        options = pc.WriteOptions(include_header=False, quoting_style="none")
+        with pc.CSVWriter(fh, schema, write_options=options) as writer:
+            for batch in batches():
+                writer.write_batch(batch)

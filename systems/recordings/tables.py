@@ -1,0 +1,186 @@
+"""Where a recording's bytes come from (a file, standard input, a pipe) and its columns of
+numbers (CSV through pyarrow's reader, numpy's for what that one does not take; Parquet),
+with errors that name the source and say what was expected."""
+from __future__ import annotations
+
+import io
+import sys
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from attitude_fmu.systems.recordings.output import STDIO
+from attitude_fmu.systems.recordings.recording import IMU_COLUMNS, PARQUET_SUFFIX, RecordingError
+
+SIGNATURES = {  # how other formats begin, to say what a file that is no text CSV is
+    b"MATLAB": "a MATLAB file: name it .mat",
+    b"\x89HDF": "an HDF5 file (MATLAB v7.3?): name it .mat",
+    b"PAR1": f"a Parquet file: name it {PARQUET_SUFFIX}",
+    b"PK\x03\x04": "a zip archive: unpack it",
+    b"\x1f\x8b": "gzip-compressed: unpack it",
+}
+
+
+@dataclass(frozen=True)
+class Source:
+    """A recording's bytes: a regular file (path), or what a stream gave (data: standard
+    input, a pipe, a process substitution), read whole. label names it in messages."""
+
+    path: Path
+    data: bytes | None = None
+
+    @classmethod
+    def of(cls, path) -> "Source":
+        """The source of path: "-" is standard input; a path that is not a regular file but
+        can be read (/dev/stdin, a named pipe) is read whole; anything else must be a file."""
+        if str(path) == STDIO:
+            return cls(Path("stdin"), sys.stdin.buffer.read())
+        path = Path(path)
+        if path.is_file():
+            return cls(path)
+        if path.exists() and not path.is_dir():
+            try:
+                return cls(path, path.read_bytes())
+            except OSError as exc:
+                raise RecordingError(f"{path}: cannot be read ({exc.strerror})") from None
+        raise RecordingError(f"{path}: {'a folder, not a file' if path.is_dir() else 'no such file'}")
+
+    @property
+    def label(self) -> str:
+        return "standard input" if self.data is not None and self.path == Path("stdin") else str(self.path)
+
+    @property
+    def suffix(self) -> str:
+        return self.path.suffix.lower()
+
+    def text(self, newline=None):
+        """The bytes as text (UTF-8, a spreadsheet's byte-order mark dropped)."""
+        if self.data is None:
+            return self.path.open(newline=newline, encoding="utf-8-sig")
+        return io.TextIOWrapper(io.BytesIO(self.data), encoding="utf-8-sig", newline=newline)
+
+    def binary(self):
+        """What pyarrow reads: the file's path, or the bytes."""
+        import pyarrow as pa
+
+        return str(self.path) if self.data is None else pa.BufferReader(self.data)
+
+    def not_text(self, exc: UnicodeDecodeError) -> RecordingError:
+        """The error for bytes that are no UTF-8 text, with what the file looks like."""
+        if self.data is None:
+            with self.path.open("rb") as fh:
+                head = fh.read(16)
+        else:
+            head = self.data[:16]
+        kind = next((what for sign, what in SIGNATURES.items() if head.startswith(sign)), None)
+        return RecordingError(f"{self.label}: not a text CSV (byte 0x{exc.object[exc.start]:02x} at offset "
+                              f"{exc.start} of a line is not UTF-8){f'; it looks like {kind}' if kind else ''}; "
+                              f"expected a CSV with the header t,{','.join(IMU_COLUMNS)}, a BROAD .mat or a "
+                              f"{PARQUET_SUFFIX} file")
+
+
+class Columns:
+    """Columns of numbers by position, read one at a time (the table they come from is
+    kept once, not copied whole): len() rows; column(i) a float array; stack(indices)
+    the N×k array of those columns."""
+
+    def __init__(self, rows: int, column):
+        self.rows, self.column = rows, column
+
+    def __len__(self) -> int:
+        return self.rows
+
+    def stack(self, indices) -> np.ndarray:
+        out = np.empty((self.rows, len(indices)))
+        for j, i in enumerate(indices):
+            out[:, j] = self.column(i)
+        return out
+
+
+def csv_numbers(source: Source, delimiter: str, width: int, skip: int, bad_line) -> Columns:
+    """The numbers of a CSV after its first skip lines, width columns separated by
+    delimiter (with ";" or a tab, "," is a decimal comma); lines starting with "#" and
+    empty ones skipped. pyarrow's reader takes them; what it refuses (a comment after the
+    numbers, ...) numpy's loadtxt tries; what neither reads, bad_line() says."""
+    import pyarrow as pa
+    import pyarrow.csv as pc
+
+    names = [f"c{i}" for i in range(width)]
+    try:
+        table = pc.read_csv(
+            source.binary(),
+            read_options=pc.ReadOptions(skip_rows=skip, column_names=names),
+            parse_options=pc.ParseOptions(delimiter=delimiter, invalid_row_handler=_comment_row),
+            convert_options=pc.ConvertOptions(column_types={n: pa.float64() for n in names}, null_values=[],
+                                              strings_can_be_null=False,
+                                              decimal_point="." if delimiter == "," else ","))
+    except (pa.ArrowInvalid, pa.ArrowNotImplementedError):
+        return _loadtxt(source, delimiter, width, skip, bad_line)
+    return Columns(table.num_rows, lambda i: floats(table.column(i)))
+
+
+def floats(column) -> np.ndarray:
+    """A pyarrow float64 column (chunked; nulls as NaN) as a numpy array, read from its
+    buffers: pyarrow's to_numpy imports pandas, a good part of a second at every start."""
+    out, at = np.empty(len(column)), 0
+    for chunk in column.chunks:
+        if chunk.null_count:
+            import pyarrow.compute
+
+            chunk = pyarrow.compute.fill_null(chunk, np.nan)
+        out[at:at + len(chunk)] = np.frombuffer(chunk.buffers()[1], dtype=np.float64, count=len(chunk),
+                                                offset=8 * chunk.offset)
+        at += len(chunk)
+    return out
+
+
+def _comment_row(row) -> str:
+    return "skip" if row.text is not None and row.text.lstrip().startswith("#") else "error"
+
+
+def _loadtxt(source: Source, delimiter: str, width: int, skip: int, bad_line) -> Columns:
+    try:
+        with warnings.catch_warnings():  # no rows: said by the caller, not as numpy's warning
+            warnings.simplefilter("ignore", UserWarning)
+            with source.text() as fh:
+                rows = fh if delimiter == "," else (decimal_points(line, delimiter) for line in fh)
+                data = np.loadtxt(rows, delimiter=delimiter, skiprows=skip, ndmin=2, dtype=float)
+    except ValueError:
+        raise RecordingError(f"{source.label}: {bad_line()}") from None
+    if data.shape[1] != width and len(data):
+        raise RecordingError(f"{source.label}: expected {width} columns of numbers, got {data.shape[1]}")
+    return Columns(len(data), lambda i: data[:, i])
+
+
+def decimal_points(line: str, delimiter: str) -> str:
+    """line with its decimal commas as points, where the separator is not the comma."""
+    return line if delimiter == "," else line.replace(",", ".")
+
+
+def parquet_header(source: Source) -> list[str]:
+    """The column names of a Parquet file."""
+    import pyarrow.parquet as pq
+
+    try:
+        return list(pq.read_schema(source.binary()).names)
+    except Exception as exc:  # pyarrow raises several types for damaged files
+        raise RecordingError(f"{source.label}: not a readable Parquet file ({exc}); expected the columns "
+                             f"t,{','.join(IMU_COLUMNS)}") from None
+
+
+def parquet_numbers(source: Source, header: list[str]) -> Columns:
+    """A Parquet file's columns (all of header, numbers of any type, read as float64)."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    try:
+        table = pq.read_table(source.binary())
+    except Exception as exc:
+        raise RecordingError(f"{source.label}: not a readable Parquet file ({exc})") from None
+    for name, field in zip(header, table.schema):
+        if not (pa.types.is_floating(field.type) or pa.types.is_integer(field.type)
+                or pa.types.is_boolean(field.type)):
+            raise RecordingError(f"{source.label}: column {name} holds {field.type}, expected numbers")
+    return Columns(table.num_rows, lambda i: floats(table.column(i).cast(pa.float64())))
