@@ -1,7 +1,8 @@
 """The C header of the native estimator's tables, written from the Python ones so that they
 cannot drift: every tuning parameter (its index, FMU unit, description and start value, in
 the order of the FMU's variables), each stage's parameters field by field as
-blocks.params.Param holds them (default NaN where Python's is None), and the fixed
+blocks.params.Param holds them (default NaN where Python's is None, the plausible range
+low and high, choices as a static array or NULL; CField), and the fixed
 transfer function of the `tseng` method (blocks.filters.tseng.earth_filter).
 
     python -m attitude_fmu.systems.fmi.native_tables DIR    # writes DIR/af_params.h
@@ -13,6 +14,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 import sys
 from pathlib import Path
 
@@ -24,7 +26,9 @@ from attitude_fmu.fmu_src.variables import tuning_parameters
 
 HEADER = "af_params.h"
 ESTIMATOR_STAGES = ("gyro_offset", "heading")  # the C names of blocks.pipeline.causal.ESTIMATORS, in its order
-C_TYPES = {"str": "const char *", "float": "double", "float | None": "double", "bool": "int", "int": "int"}
+C_TYPES = {"str": "const char *", "float": "double", "bool": "int", "int": "int"}  # of a Param field's values
+NONE_IN_C = {"float": "NAN", "str": "NULL"}  # None as an optional field's C value (where its type has one)
+TUPLE = re.compile(r"tuple\[(\w+), \.\.\.\]")  # a field of several values: tuple[float, ...]
 C_KEYWORDS = {  # C99's
     "auto", "break", "case", "char", "const", "continue", "default", "do", "double", "else", "enum", "extern", "float",
     "for", "goto", "if", "inline", "int", "long", "register", "restrict", "return", "short", "signed", "sizeof",
@@ -66,6 +70,7 @@ def c_double(value: float | None) -> str:
 
 
 def c_value(value, type_name: str) -> str:
+    """value as a C literal of the Param field type type_name (a key of C_TYPES)."""
     if type_name == "str":
         return c_string(value)
     if type_name in ("bool", "int"):
@@ -73,15 +78,66 @@ def c_value(value, type_name: str) -> str:
     return c_double(value)
 
 
-def _param_fields() -> list[tuple[str, str, str]]:
-    """(Python name, C name, Python type) of every field of blocks.params.Param."""
+@dataclasses.dataclass(frozen=True)
+class CField:
+    """A field of blocks.params.Param as AfStageParam holds it: one value of the C type of
+    element (C_TYPES), or, where sequence (tuple[element, ...]), a pointer to a static array
+    of them (NULL for None) and their count n_<name>; None where optional (X | None)."""
+
+    name: str  # Python's
+    c_name: str  # name, or name_value where name is a C keyword
+    element: str  # a key of C_TYPES
+    sequence: bool
+    optional: bool
+
+    def members(self) -> list[str]:
+        """Its declarations in AfStageParam."""
+        c_type = C_TYPES[self.element]
+        if not self.sequence:
+            return [f"{c_type}{'' if c_type.endswith('*') else ' '}{self.c_name};"]
+        pointer = f"{c_type}const *" if c_type.endswith("*") else f"const {c_type} *"
+        return [f"{pointer}{self.c_name};{' /* NULL: None */' if self.optional else ''}", f"int n_{self.name};"]
+
+    def array(self, value, array_name: str) -> str | None:
+        """The static array that holds a sequence's value (None where no array is needed)."""
+        if not self.sequence or value is None:
+            return None
+        if not value:
+            raise ValueError(f"Param.{self.name}: an empty tuple has no C array (give None)")
+        items = ", ".join(c_value(v, self.element) for v in value)
+        return f"static const {C_TYPES[self.element]} {array_name}[{len(value)}] = {{{items}}};"
+
+    def initialiser(self, value, array_name: str) -> str:
+        """Its value in AfStageParam's initialiser."""
+        if value is None:
+            if not self.optional:
+                raise ValueError(f"Param.{self.name}: None where its type is not optional")
+            if self.sequence:
+                return "NULL, 0"
+            if self.element not in NONE_IN_C:
+                raise ValueError(f"Param.{self.name}: no C value stands for None in a {self.element}")
+            return NONE_IN_C[self.element]
+        return f"{array_name}, {len(value)}" if self.sequence else c_value(value, self.element)
+
+
+def _param_fields() -> list[CField]:
+    """Every field of blocks.params.Param, in its order, as C holds it: a type of C_TYPES, or
+    tuple[T, ...] of one, either optionally | None."""
     fields = []
     for field in dataclasses.fields(Param):
         # a string where the annotations are postponed; else the type itself ("float | None" as str())
-        type_name = field.type if isinstance(field.type, str) else getattr(field.type, "__name__", str(field.type))
-        if type_name not in C_TYPES:
-            raise ValueError(f"Param.{field.name}: no C type for {type_name!r} (native_tables.C_TYPES)")
-        fields.append((field.name, field.name + "_value" if field.name in C_KEYWORDS else field.name, type_name))
+        type_name = field.type if isinstance(field.type, str) else (
+            field.type.__name__ if isinstance(field.type, type) else str(field.type))
+        parts = [part.strip() for part in type_name.split("|")]
+        optional = "None" in parts
+        kinds = [part for part in parts if part != "None"]
+        sequence = len(kinds) == 1 and TUPLE.fullmatch(kinds[0])
+        element = sequence.group(1) if sequence else kinds[0] if len(kinds) == 1 else None
+        if element not in C_TYPES:
+            raise ValueError(f"Param.{field.name}: no C type for {type_name!r} (native_tables.C_TYPES, "
+                             "tuple[T, ...] of one, either | None)")
+        c_name = field.name + "_value" if field.name in C_KEYWORDS else field.name
+        fields.append(CField(field.name, c_name, element, bool(sequence), optional))
     return fields
 
 
@@ -135,11 +191,11 @@ def header_text() -> str:
         "};",
         "",
         "/* One parameter of a stage, field by field as blocks.params.Param (NaN where its default is",
-        " * None), with its index into the AF_N_PARAMS values. */",
+        " * None; a tuple as its values and their count n_<name>, NULL where None), with its index",
+        " * into the AF_N_PARAMS values. */",
         "typedef struct {",
         "    int index;",
-        *(f"    {C_TYPES[type_name]}{'' if C_TYPES[type_name].endswith('*') else ' '}{c_name};"
-          for _, c_name, type_name in fields),
+        *(f"    {member}" for field in fields for member in field.members()),
         "} AfStageParam;",
         "",
         "typedef struct {",
@@ -154,9 +210,12 @@ def header_text() -> str:
     for name, _, _, stage_params in all_stages:
         if not stage_params:
             continue
+        arrays = {(p.name, f.name): f"AF_STAGE_PARAMS_{name}_{p.name}_{f.name}" for p in stage_params for f in fields}
+        lines += [text for p in stage_params for f in fields
+                  if (text := f.array(getattr(p, f.name), arrays[p.name, f.name])) is not None]
         lines.append(f"static const AfStageParam AF_STAGE_PARAMS_{name}[{len(stage_params)}] = {{")
         for p in stage_params:
-            values = ", ".join(c_value(getattr(p, py_name), type_name) for py_name, _, type_name in fields)
+            values = ", ".join(f.initialiser(getattr(p, f.name), arrays[p.name, f.name]) for f in fields)
             lines.append(f"    {{AF_P_{p.name}, {values}}},")
         lines.append("};")
     lines += [

@@ -1,7 +1,9 @@
-/* params.c: Python twin blocks/params.py (resolve_params), with the same refusals and messages. */
+/* params.c: Python twin blocks/params.py (resolve_params, Param.range_text, _unit), with the same
+ * refusals and messages. */
 #include "params.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "messages.h"
@@ -14,11 +16,48 @@ const AfStageParam *stage_param(int stage, int index)
     return NULL;
 }
 
+/* _unit: the unit as messages append it ("" for "1", else " <unit>") */
+static const char *unit_text(const AfStageParam *p)
+{
+    return strcmp(p->unit, "1") == 0 ? "" : p->unit;
+}
+
+const char *range_text(const AfStageParam *p, char *out, size_t size)
+{
+    char low[FLOAT_REPR_SIZE] = "0";
+    if (!(p->allow_zero || p->low == 0)) snprintf(low, sizeof low, "%g", p->low);
+    snprintf(out, size, "%s%s, %g]%s%s", p->allow_zero || p->low > 0 ? "[" : "(", low, p->high,
+             *unit_text(p) ? " " : "", unit_text(p));
+    return out;
+}
+
+/* a value of the parameter p refused as resolve_params refuses it (0: taken) */
+static int check_value(const AfStageParam *p, double v, char *message, size_t size)
+{
+    char value[FLOAT_REPR_SIZE], range[RANGE_TEXT_SIZE], choices[256] = "";
+    int i, chosen = 0;
+    if (!(isfinite(v) && (p->allow_zero ? v >= 0 : v > 0)))
+        return refuse(message, size, "parameter %s must be a finite %s number (%s), got %s", p->name,
+                      p->allow_zero ? "non-negative" : "positive", range_text(p, range, sizeof range),
+                      float_repr(v, value));
+    for (i = 0; p->choices != NULL && i < p->n_choices; i++) {
+        chosen |= v == p->choices[i];
+        snprintf(choices + strlen(choices), sizeof choices - strlen(choices), "%s%g", i ? " or " : "", p->choices[i]);
+    }
+    if (p->choices != NULL && !chosen)
+        return refuse(message, size, "parameter %s must be %s, got %s (%s)", p->name, choices, float_repr(v, value),
+                      p->doc);
+    if (!(p->low <= v && v <= p->high))
+        return refuse(message, size, "parameter %s = %g%s%s is outside its plausible range %s (%s)", p->name, v,
+                      *unit_text(p) ? " " : "", unit_text(p), range_text(p, range, sizeof range), p->doc);
+    return 0;
+}
+
 int resolve_params(int stage, const double given[AF_N_PARAMS], double resolved[AF_N_PARAMS], char *message,
                    size_t size)
 {
     const AfStage *s = &AF_STAGES[stage];
-    char value[FLOAT_REPR_SIZE], name[64], known[1024] = "";
+    char name[64], known[1024] = "";
     int i;
     for (i = 0; i < AF_N_PARAMS; i++) {
         resolved[i] = NAN;
@@ -38,9 +77,7 @@ int resolve_params(int stage, const double given[AF_N_PARAMS], double resolved[A
             resolved[p->index] = p->default_value;
             continue;
         }
-        if (!(isfinite(v) && (p->allow_zero ? v >= 0 : v > 0)))
-            return refuse(message, size, "parameter %s must be a finite %s number, got %s", p->name,
-                          p->allow_zero ? "non-negative" : "positive", float_repr(v, value));
+        if (check_value(p, v, message, size)) return -1;
         resolved[p->index] = v;
     }
     return 0;

@@ -3,12 +3,34 @@
 
 #include <math.h>
 
-void mahony_coefficients(const double params[AF_N_PARAMS], double Ts, double coef[MAHONY_COEF_SIZE])
+#include "messages.h"
+
+int mahony_check_gains(double k_P, double k_I, double Ts, char *message, size_t size)
 {
+    /* "k_P\302\267Ts": k_P·Ts; "1/s\302\262": 1/s²; "\342\210\222": − (UTF-8, as Python's message) */
+    if (k_P * Ts >= 2.0)
+        return refuse(message, size,
+                      "parameter k_P = %g 1/s is unstable at the sample time %g s: Mahony's step needs "
+                      "k_P\302\267Ts < 2, k_P < %g 1/s at %g Hz",
+                      k_P, Ts, 2.0 / Ts, 1.0 / Ts);
+    if (k_I * Ts * Ts >= 4.0 - 2.0 * k_P * Ts)
+        return refuse(message, size,
+                      "parameter k_I = %g 1/s\302\262 is unstable with k_P = %g 1/s at the sample time %g s: "
+                      "Mahony's step needs k_I\302\267Ts\302\262 < 4 \342\210\222 2\302\267k_P\302\267Ts, "
+                      "k_I < %g 1/s\302\262 at %g Hz",
+                      k_I, k_P, Ts, (4.0 - 2.0 * k_P * Ts) / (Ts * Ts), 1.0 / Ts);
+    return 0;
+}
+
+int mahony_coefficients(const double params[AF_N_PARAMS], double Ts, double coef[MAHONY_COEF_SIZE], char *message,
+                        size_t size)
+{
+    if (mahony_check_gains(params[AF_P_k_P], params[AF_P_k_I], Ts, message, size)) return -1;
     coef[0] = params[AF_P_k_P];
     coef[1] = params[AF_P_k_I];
     coef[2] = Ts;
     coef[3] = params[AF_P_g];
+    return 0;
 }
 
 void mahony_initial_state(const double coef[MAHONY_COEF_SIZE], const double acc0[3], double state[MAHONY_STATE_SIZE])

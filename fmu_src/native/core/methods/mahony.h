@@ -10,7 +10,16 @@
 #define MAHONY_STATE_SIZE 7 /* q_w, q_x, q_y, q_z, b_x, b_y, b_z: q sensor -> earth, gyro bias (rad/s) */
 #define MAHONY_COEF_SIZE 4  /* [k_P (1/s), k_I (1/s^2), Ts (s), g (m/s^2)] */
 
-void mahony_coefficients(const double params[AF_N_PARAMS], double Ts, double coef[MAHONY_COEF_SIZE]);
+#include <stddef.h>
+
+/* check_gains: 0, or -1 with Python's message for gains k_P (1/s) and k_I (1/s^2) with which
+ * the step diverges at the sample time Ts (s): k_P Ts < 2 and k_I Ts^2 < 4 - 2 k_P Ts hold
+ * where the linearised step's poles lie inside the unit circle. */
+int mahony_check_gains(double k_P, double k_I, double Ts, char *message, size_t size);
+
+/* coefficients(params, Ts): 0, or -1 with check_gains's message. */
+int mahony_coefficients(const double params[AF_N_PARAMS], double Ts, double coef[MAHONY_COEF_SIZE], char *message,
+                        size_t size);
 
 /* Level on acc0 (heading 0), no bias. */
 void mahony_initial_state(const double coef[MAHONY_COEF_SIZE], const double acc0[3], double state[MAHONY_STATE_SIZE]);

@@ -46,13 +46,9 @@ static int stationary_omega_g(const double *p, double *out, char *message, size_
                    message, size);
 }
 
-/* _wiener_is_local: whether `wiener` runs its local kernel; -1 with a message for a stationary other than 0 or 1 */
-static int wiener_is_local(const double *p, char *message, size_t size)
+/* _wiener_is_local: whether `wiener` runs its local kernel (resolve_params took a stationary of 0 or 1 only) */
+static int wiener_is_local(const double *p)
 {
-    char text[FLOAT_REPR_SIZE];
-    if (p[AF_P_stationary] != 0.0 && p[AF_P_stationary] != 1.0)
-        return refuse(message, size, "parameter stationary must be 0 or 1, got %s",
-                      float_repr(p[AF_P_stationary], text));
     return p[AF_P_stationary] == 0.0 && isnan(p[AF_P_omega_g]) && isnan(p[AF_P_omega_c]) && isnan(p[AF_P_delta_v]);
 }
 
@@ -104,14 +100,12 @@ static int finite_values(const double *values, int n)
 int method_configure(AfMethod *m, int index, const double given[AF_N_PARAMS], char *message, size_t size)
 {
     char text[512];
-    int local;
     memset(m, 0, sizeof *m);
     m->method = index;
     if (resolve_params(index, given, m->params, message, size)) return -1;
     switch (index) {
     case AF_STAGE_wiener:
-        if ((local = wiener_is_local(m->params, message, size)) < 0) return -1;
-        m->kernel = local ? KERNEL_WIENER_LOCAL : KERNEL_NONE;
+        m->kernel = wiener_is_local(m->params) ? KERNEL_WIENER_LOCAL : KERNEL_NONE;
         break;
     case AF_STAGE_tseng_adaptive: m->kernel = KERNEL_TSENG_ADAPTIVE; break;
     case AF_STAGE_luinge: m->kernel = KERNEL_LUINGE; break;
@@ -165,8 +159,8 @@ int stepper_at(AfStepper *s, const AfMethod *m, double Ts, char *message, size_t
             wiener_local_coefficients(m->params, Ts, s->coef);
         } else if (m->kernel == KERNEL_LUINGE) {
             luinge_coefficients(m->params, Ts, s->coef);
-        } else {
-            mahony_coefficients(m->params, Ts, s->coef);
+        } else if (mahony_coefficients(m->params, Ts, s->coef, message, size)) {
+            return -1;
         }
         s->state_size = KERNELS[m->kernel].state_size;
         finite = finite_values(s->coef, KERNELS[m->kernel].coef_size);

@@ -44,17 +44,18 @@ typedef struct {
 int method_index(const char *name, char *message, size_t size);
 
 /* The method of index with the values given: resolved (Method.resolve: blocks/params.py's
- * refusals and messages), what it runs decided (runs_kernel; `wiener` refuses a stationary
- * other than 0 or 1) and, for a sensor-frame method, its earth filter designed (Method.filter,
+ * refusals and messages: ranges, and a stationary other than 0 or 1), what it runs decided
+ * (runs_kernel) and, for a sensor-frame method, its earth filter designed (Method.filter,
  * with the design's refusals, e.g. omega_c too low for eq. 33, and a filter whose coefficients
  * overflow). given: NaN where not given; a value for a name the method lacks is refused.
  * 0, or -1 with a message. */
 int method_configure(AfMethod *m, int index, const double given[AF_N_PARAMS], char *message, size_t size);
 
 /* stepper(name, params, Ts): the method's step at the sample time Ts (s), for any Ts (the
- * zero-order hold computed again). 0, or -1 with a message: Ts not finite and positive, or
- * coefficients that overflow at Ts (e.g. delta_n = 1e300; call it once with the nominal Ts
- * at initialisation to refuse such parameters there). */
+ * zero-order hold computed again). 0, or -1 with a message: Ts not finite and positive, Mahony
+ * gains that diverge at Ts (`mahony` and `tseng_adaptive`: mahony_check_gains), or coefficients
+ * that overflow at Ts; call it once with the nominal Ts at initialisation to refuse such
+ * parameters there. */
 int stepper_at(AfStepper *s, const AfMethod *m, double Ts, char *message, size_t size);
 
 /* initial_state(gravity): at rest on gravity (m/s^2, sensor coordinates; e.g. start_gravity

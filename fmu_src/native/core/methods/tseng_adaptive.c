@@ -15,6 +15,7 @@ int tseng_adaptive_coefficients(const double params[AF_N_PARAMS], double Ts, dou
     DiscreteFilter disc;
     double X[3 * MAX_ORDER];
     int n, j;
+    if (mahony_check_gains(params[AF_P_k_P], params[AF_P_k_I], Ts, message, size)) return -1; /* its Mahony mode's */
     tseng_earth_filter(&f);
     if (discrete_filter(&f, Ts, &disc, message, size)) return -1;
     n = disc.n;

@@ -15,8 +15,9 @@
 #define TSENG_ADAPTIVE_STATE_SIZE (3 * TSENG_ORDER + 7)
 #define TSENG_ADAPTIVE_COEF_SIZE (7 + TSENG_ORDER * TSENG_ORDER + 3 * TSENG_ORDER)
 
-/* coefficients(params, Ts): the tseng filter held over Ts (s). 0, or -1 with the message of a
- * Ts that is not finite and positive. */
+/* coefficients(params, Ts): the tseng filter held over Ts (s). 0, or -1 with the message of
+ * Mahony gains that diverge at Ts (mahony_check_gains, for its Mahony mode) or of a Ts that is
+ * not finite and positive. */
 int tseng_adaptive_coefficients(const double params[AF_N_PARAMS], double Ts, double coef[TSENG_ADAPTIVE_COEF_SIZE],
                                 char *message, size_t size);
 

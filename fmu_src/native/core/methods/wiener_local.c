@@ -9,8 +9,8 @@
 
 double band_pass_variance(double omega_m, double tau_v)
 {
-    double c = omega_m * tau_v, r = c / (1.0 + c);
-    return r * r * (2.0 * c + 1.0) / (8.0 * tau_v);
+    double c = omega_m * tau_v;
+    return c * c * (2.0 * c + 1.0) / (8.0 * tau_v * pow(c + 1.0, 2.0)); /* Python's J, operation for operation */
 }
 
 void wiener_local_coefficients(const double params[AF_N_PARAMS], double Ts, double coef[WIENER_LOCAL_COEF_SIZE])

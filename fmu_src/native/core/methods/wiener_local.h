@@ -22,7 +22,7 @@
 /* J, the variance per unit density that the band-pass of time constant tau_v (s) leaves of
  * eq. 14's velocity band-limited at omega_m (rad/s): (1/2 pi) int (w tau_v)^4 / (1 + w^2
  * tau_v^2)^2 / (1 + w^2/omega_m^2) dw, in closed form c^2 (2c + 1) / (8 tau_v (1 + c)^2),
- * c = omega_m tau_v (Python integrates it with scipy's quad). */
+ * c = omega_m tau_v, the formula of Python's coefficients. */
 double band_pass_variance(double omega_m, double tau_v);
 
 /* coefficients(params, Ts): params the method's resolved values (AF_P_<name>), Ts s. */
