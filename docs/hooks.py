@@ -8,6 +8,8 @@ descriptions a build writes (built once per docs build, into a temporary folder)
 from __future__ import annotations
 
 import argparse
+import atexit
+import shutil
 import tempfile
 from functools import lru_cache
 from pathlib import Path
@@ -86,6 +88,7 @@ def _built_fmus() -> Path:
     from attitude_fmu.systems.fmi.build import build_fmus
 
     folder = Path(tempfile.mkdtemp(prefix="attitude_docs_"))
+    atexit.register(shutil.rmtree, folder, True)
     build_fmus(folder)
     return folder
 

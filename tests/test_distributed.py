@@ -19,7 +19,7 @@ from scipy.io import savemat
 from scipy.spatial.transform import Rotation
 
 from attitude_fmu.systems.cli.commands import main
-from attitude_fmu.systems.cluster.jobs import Failure, Jobs
+from attitude_fmu.systems.cluster.jobs import Jobs
 from attitude_fmu.systems.evaluation.evaluate import METRICS, evaluate
 from attitude_fmu.systems.evaluation.sweep import TUNING_WARNING
 from attitude_fmu.systems.simulation.motion import ClosedFormMotion

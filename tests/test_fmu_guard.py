@@ -9,7 +9,6 @@ import textwrap
 from pathlib import Path
 
 import numpy as np
-import pytest
 from fmpy import extract
 from fmpy.fmi1 import FMICallException
 

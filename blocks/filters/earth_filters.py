@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import math
 
-
 STANDARD_GRAVITY = 9.81  # m/s², the value the project uses for |g|
 
 

@@ -122,6 +122,7 @@ def euler_complementary(gyr, acc, fs: float):
     integrated through the Z-Y-X Euler kinematics (singular at pitch ±90°), combined as
     C·(G_LA·θ_acc + G_H·θ_gyro). Returns roll, pitch (rad) per sample."""
     import control
+
     from attitude_fmu.blocks.filters.sensor_frame import DiscreteFilter
 
     gyr, acc = np.asarray(gyr, dtype=float), np.asarray(acc, dtype=float)

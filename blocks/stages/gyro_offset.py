@@ -46,7 +46,7 @@ from attitude_fmu.blocks.control_system import sample_system
 from attitude_fmu.blocks.filters.sensor_frame import time_reversed
 from attitude_fmu.blocks.jit import kernel
 from attitude_fmu.blocks.methods.wiener_local import butterworth_zoh
-from attitude_fmu.blocks.params import GYRO_NOISE, Param, RATE_RAD_S, TIME_S, resolve_params
+from attitude_fmu.blocks.params import GYRO_NOISE, RATE_RAD_S, TIME_S, Param, resolve_params
 from attitude_fmu.blocks.quaternion import quat_matrix, quat_multiply, quat_normalized, rotvec_quat
 
 REST_NOISE_SIGMAS = 4.5  # the least rest_gyr in units of the gyro noise's per-axis s.d. through tau_short

@@ -46,7 +46,7 @@ import math
 import numpy as np
 
 from attitude_fmu.blocks.jit import kernel
-from attitude_fmu.blocks.params import FRACTION, Param, TIME_S
+from attitude_fmu.blocks.params import FRACTION, TIME_S, Param
 
 PARAMS = (
     Param("mag_cal_time", 60.0, "s", "time over which the hard-iron fit forgets its samples (0: no hard-iron estimate)",

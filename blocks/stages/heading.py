@@ -38,7 +38,7 @@ import numpy as np
 
 from attitude_fmu.blocks.control_system import sample_system
 from attitude_fmu.blocks.jit import kernel
-from attitude_fmu.blocks.params import ANGLE_RAD, Param, TIME_S, resolve_params
+from attitude_fmu.blocks.params import ANGLE_RAD, TIME_S, Param, resolve_params
 from attitude_fmu.blocks.quaternion import quat_multiply, quat_rotate, rotvec_quat
 from attitude_fmu.blocks.stages import hard_iron, mag_delay
 from attitude_fmu.blocks.stages.hard_iron import hard_iron_step, pull

@@ -24,7 +24,7 @@ import math
 import numpy as np
 
 from attitude_fmu.blocks.jit import kernel
-from attitude_fmu.blocks.params import Param, TIME_S
+from attitude_fmu.blocks.params import TIME_S, Param
 
 MAG_SPAN_S = 0.25  # s: the field is compared with the gyro over about this long
 MAG_DELAY_REACH_S = 0.1  # s: the largest delay looked for

@@ -26,8 +26,8 @@ import sysconfig
 import tempfile
 import uuid
 import zipfile
-from importlib.metadata import version
 from dataclasses import dataclass
+from importlib.metadata import version
 from pathlib import Path
 from xml.etree.ElementTree import Element, SubElement, tostring
 

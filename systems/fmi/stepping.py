@@ -4,7 +4,9 @@ FMUs compute rather than a Python loop of FMI calls through fmpy (verify's human
 at 50 Hz on the native chain: 0.09 s of CPU against 0.5 s, setup included)."""
 from __future__ import annotations
 
+import atexit
 import ctypes
+import shutil
 import subprocess
 import tempfile
 from functools import cache
@@ -33,6 +35,7 @@ class SteppedComponent(ctypes.Structure):
 def library():
     """stepping.c compiled and loaded (kept for the process), or None without a working C compiler."""
     folder = Path(tempfile.mkdtemp(prefix="attitude_stepping_"))
+    atexit.register(shutil.rmtree, folder, True)  # the loaded library stays mapped; its folder goes at exit
     out = folder / "stepping.so"
     command = [*compiler(), "-std=c99", "-O2", "-fPIC", "-shared", f"-I{FMI_HEADERS}", "-o", str(out), str(SOURCE)]
     try:
