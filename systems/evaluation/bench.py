@@ -165,7 +165,7 @@ def bench_fmu(steps: int = 5000, repeat: int = 5, progress: bool = True) -> dict
         if progress:
             print("bench: building AttitudeEstimator.fmu and NoOpEstimator.fmu, pythonfmu and native",
                   file=sys.stderr, flush=True)
-        paths = build_fmus(tmp, names, names)
+        paths = build_fmus(tmp, names, names, fmi3_names=())
         fmus = {}
         for path in paths:
             name = path.stem if path.parent == Path(tmp) else f"native/{path.stem}"
