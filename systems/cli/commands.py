@@ -95,6 +95,17 @@ def _add_real_data_flags(parser) -> None:
                         help="heading from the magnetometer when the input has one (default), or the gyro's (6D)")
 
 
+def _add_method_flags(parser, param_help: str = "a parameter of the method, the gyro-offset or the heading "
+                      "estimator, in its unit (attitude estimate -h lists them); repeatable") -> None:
+    parser.add_argument("--method", default="wiener", choices=sorted(METHODS),
+                        help="the estimator (default wiener; attitude estimate -h says what each is)")
+    parser.add_argument("--param", type=_param, action="append", default=[], metavar="NAME=VALUE", help=param_help)
+
+
+def _add_json_flag(parser, instead_of: str = "the table") -> None:
+    parser.add_argument("--json", action="store_true", help=f"print JSON instead of {instead_of}")
+
+
 def _add_input_flags(parser) -> None:
     parser.add_argument("--fs", type=float, help="sample rate in Hz (required when a CSV has no t column)")
     parser.add_argument("--gyr-unit", default="rad/s", choices=list(GYR_UNITS), help="gyro unit (default rad/s)")
@@ -192,8 +203,8 @@ def build_parser() -> argparse.ArgumentParser:
         epilog="methods and estimators, and their parameters (a name under several sets it in each):\n" + _method_help(),
     )
     est.add_argument("input", nargs="+", help="CSV (t,gyr_x,gyr_y,gyr_z,acc_x,acc_y,acc_z[,mag_x,mag_y,mag_z]; "
-                     "separated by commas, semicolons or tabs) or BROAD .mat; several: each is estimated "
-                     "with the same flags")
+                     "separated by commas, semicolons or tabs; - for standard input), Parquet (.parquet, the "
+                     "same columns) or BROAD .mat; several: each is estimated with the same flags")
     est.add_argument("--out", required=True, help="output CSV: t,q_w,q_x,q_y,q_z,g_x,g_y,g_z; or a folder that receives "
                      "NAME.csv for input NAME.csv or NAME.mat (with several inputs, made if absent)")
     est.add_argument("--euler", action="store_true",
@@ -203,19 +214,16 @@ def build_parser() -> argparse.ArgumentParser:
                           "sample; 0 with --gyro-offset off) and, with magnetometer heading, mag_offset_x,mag_offset_y,"
                           "mag_offset_z (µT, the hard-iron estimate) and mag_delay (s, the magnetometer's delay "
                           "behind the gyro allowed for)")
-    est.add_argument("--method", default="wiener", choices=sorted(METHODS))
-    est.add_argument("--param", type=_param, action="append", default=[], metavar="NAME=VALUE",
-                     help="parameter of the method, the gyro-offset or the heading estimator, in the unit listed "
-                          "below; repeatable")
+    _add_method_flags(est, "parameter of the method, the gyro-offset or the heading estimator, in the unit listed "
+                           "below; repeatable")
     _add_input_flags(est)
     _add_real_data_flags(est)
 
     ev = sub.add_parser("evaluate", help="errors against an optical reference (BROAD .mat, or a CSV with "
                                          f"{','.join(REF_COLUMNS)}[,{MOVEMENT_COLUMN}]), beside vqf and madgwick")
-    ev.add_argument("files", nargs="+", metavar="FILE")
-    ev.add_argument("--method", default="wiener", choices=sorted(METHODS))
-    ev.add_argument("--param", type=_param, action="append", default=[], metavar="NAME=VALUE")
-    ev.add_argument("--json", action="store_true")
+    ev.add_argument("files", nargs="+", metavar="FILE", help="recordings with a reference")
+    _add_method_flags(ev)
+    _add_json_flag(ev)
     ev.add_argument("--start-in-movement", type=float, metavar="S",
                     help="begin each recording S seconds into its movement phase: no rest before, "
                          "a first sample in motion (a test of start-up and offset tracking)")
@@ -225,8 +233,10 @@ def build_parser() -> argparse.ArgumentParser:
 
     sw = sub.add_parser("sweep", help="every combination of a parameter grid on every recording with a reference: "
                                       "errors per recording and on average, and the best combination")
-    sw.add_argument("files", nargs="+", metavar="FILE")
-    sw.add_argument("--method", default="wiener", choices=sorted(METHODS))
+    sw.add_argument("files", nargs="+", metavar="FILE", help="recordings with a reference, on which every "
+                    "combination is run")
+    sw.add_argument("--method", default="wiener", choices=sorted(METHODS),
+                    help="the estimator whose parameters the grid sets (default wiener)")
     sw.add_argument("--grid", type=_grid, action="append", default=[], metavar="NAME=V1,V2,...", required=True,
                     help="values of a parameter of the method, the gyro-offset or the heading estimator, in its "
                          "unit (attitude estimate -h lists them); repeatable: every combination is run")
@@ -238,7 +248,7 @@ def build_parser() -> argparse.ArgumentParser:
     sw.add_argument("--by", default="inclination", choices=["inclination", "heading", "total"],
                     help="the mean RMSE the best combination has the lowest of (default inclination)")
     out = sw.add_mutually_exclusive_group()
-    out.add_argument("--json", action="store_true", help="print JSON instead of the table")
+    _add_json_flag(out)
     out.add_argument("--csv", metavar="OUT", help="also write every combination's errors per recording to OUT")
     sw.add_argument("--start-in-movement", type=float, metavar="S",
                     help="begin each recording S seconds into its movement phase")
@@ -248,25 +258,22 @@ def build_parser() -> argparse.ArgumentParser:
 
     pl = sub.add_parser("plot", help="a recording's error over time and its spectrum against eq. 42 (PNG); "
                         "without a reference, the estimate's angles over time")
-    pl.add_argument("file", metavar="FILE")
-    pl.add_argument("--method", default="wiener", choices=sorted(METHODS))
+    pl.add_argument("file", metavar="FILE", help="a recording, as attitude estimate reads it")
     pl.add_argument("--out", required=True, help="PNG to write")
-    pl.add_argument("--param", type=_param, action="append", default=[], metavar="NAME=VALUE")
-    pl.add_argument("--offline", action="store_true")
-    pl.add_argument("--gyro-offset", default="on", choices=["on", "off"])
-    pl.add_argument("--heading", default="mag", choices=["mag", "gyro"],
-                    help="with a magnetometer in the recording, also the heading error (default), or not")
+    _add_method_flags(pl)
+    _add_real_data_flags(pl)
     _add_input_flags(pl)
 
     t1 = sub.add_parser("table1", help="Rizun's Table 1: analytic (eq. 50) and simulated RMS attitude error")
-    t1.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    _add_json_flag(t1)
     t1.add_argument("--duration", type=float, default=20000.0, help="simulated seconds per cell (default 20000)")
     t1.add_argument("--fs", type=float, default=100.0, help="simulation sample rate, Hz (default 100)")
-    t1.add_argument("--seed", type=int, default=0)
+    t1.add_argument("--seed", type=int, default=0, help="random seed: cell j of row i simulates with seed + 10·i + j "
+                    "(default 0)")
     _add_cluster_flags(t1, "cells")
 
     vf = sub.add_parser("verify", help="co-simulate every profile with every estimator as FMUs; exit 1 if a bound is missed")
-    vf.add_argument("--json", action="store_true")
+    _add_json_flag(vf)
     _add_verify_flags(vf)
     _add_cluster_flags(vf, "co-simulations (profile × method)")
     vf.add_argument("--python", action="store_true", help="also run the pythonfmu chain and hold its estimator "
@@ -281,7 +288,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     cp = sub.add_parser("compare", help="every estimator and the peers vqf, madgwick on every motion profile")
     cp.add_argument("--profile", action="append", help="only this profile (repeatable)")
-    cp.add_argument("--json", action="store_true")
+    _add_json_flag(cp)
     cp.add_argument("--gyro-noise", type=float, default=0.02, metavar="DEG_S_RTHZ",
                     help="the simulated gyro's white noise, °/s/√Hz (default 0.02)")
     cp.add_argument("--acc-noise", type=float, default=0.002, metavar="M_S2_RTHZ",
@@ -294,11 +301,12 @@ def build_parser() -> argparse.ArgumentParser:
     _add_cluster_flags(cp, "profiles")
 
     bd = sub.add_parser("bode", help="frequency response of a method's filter (tseng: also Tseng Figs. 6-7)")
-    bd.add_argument("--method", default="tseng", choices=sorted(m for m in METHODS if METHODS[m].is_sensor_frame))
+    bd.add_argument("--method", default="tseng", choices=sorted(m for m in METHODS if METHODS[m].is_sensor_frame),
+                    help="a method with an earth-frame filter (default tseng)")
     bd.add_argument("--out", help="PNG to write (default bode_METHOD.png)")
 
     bn = sub.add_parser("bench", help="samples per second of the batch estimator, vqf and ahrs Madgwick")
-    bn.add_argument("--json", action="store_true")
+    _add_json_flag(bn, "the lines")
     bn.add_argument("--samples", type=int, help="samples of the recording (default 100000; with --io 1000000)")
     bn.add_argument("--fmu", action="store_true",
                     help="per-step cost of AttitudeEstimator.fmu against a no-op FMU of the same interface, pythonfmu "
