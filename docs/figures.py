@@ -3,7 +3,8 @@
     python docs/figures.py [--broad DIR] [--only NAME ...]
 
 runs `attitude table1 --json`, `attitude evaluate --json` (online and --offline) on the BROAD
-recordings, `attitude compare --json`, `attitude verify --json`, `attitude bench --json`,
+recordings, `attitude compare --json`, `attitude verify --json`, `attitude bench --json` (also
+`--fmu`, `--io` and `--workers 2`),
 `attitude bode` and `attitude plot`, writes what each printed to docs/generated/NAME.json, and
 from those files the Markdown tables (NAME.md, included by the pages) and the figures
 (NAME.png). Running it again refreshes every number and picture in docs/results/. It takes
@@ -189,6 +190,45 @@ def bench(refresh: bool) -> None:
     write_md("bench", lines + ["", f"{data['samples']} samples, best of the runs, all in one process."])
 
 
+def bench_fmu(refresh: bool) -> None:
+    data = run_json("bench_fmu", "bench", "--fmu", "--repeat", "10") if refresh else load("bench_fmu")
+    lines = ["| FMU | µs per step under fmpy |", "|---|---:|"]
+    lines += [f"| {name} | {us:.2f} |" for name, us in data["us_per_step"].items()]
+    lines += ["", "| FMU | µs per step in a C host |", "|---|---:|"]
+    lines += [f"| {name} | {us:.3f} |" for name, us in data["c_host_us_per_step"].items()]
+    lines += ["", f"Under fmpy the native estimator costs {data['native_ratio_vs_noop']:.2f}× a native no-op FMU of "
+              f"its interface (the pythonfmu one {data['ratio_vs_noop']:.2f}× its no-op); in a C host it is "
+              f"{data['native_speedup_c_host']:.0f}× faster than the pythonfmu estimator ({data['steps']} steps, "
+              "best of interleaved rounds, one process)."]
+    write_md("bench_fmu", lines)
+
+
+def bench_io(refresh: bool) -> None:
+    data = run_json("bench_io", "bench", "--io") if refresh else load("bench_io")
+    mb = lambda b: f"{b / 1e6:.0f} MB"
+    rec = data["recording"]
+    lines = ["| way | seconds | × pandas + vqf 9D + pandas | peak memory |", "|---|---:|---:|---:|"]
+    for name, seconds in data["seconds"].items():
+        memory = data["peak_memory_bytes"].get(name)
+        lines.append(f"| {name} | {seconds:.2f} | {data['ratio_vs_peers'][name]:.2f} | {mb(memory) if memory else ''} |")
+    lines += ["", f"{data['samples']} samples at {data['fs_hz']:g} Hz with a magnetometer: columns "
+              f"{mb(rec['array_bytes'])}, CSV {mb(rec['csv_bytes'])}, Parquet {mb(rec['parquet_bytes'])}; a process "
+              f"estimating one second of it peaks at {mb(data['peak_memory_bytes']['one_second'])}."]
+    write_md("bench_io", lines)
+
+
+def bench_workers(refresh: bool) -> None:
+    data = (run_json("bench_workers", "bench", "--workers", "2", "--recordings", *map(str, sorted(BROAD.glob("*.mat"))))
+            if refresh else load("bench_workers"))
+    lines = ["| command | jobs | 1 process, s | 2 workers, s | speed-up | same output |", "|---|---:|---:|---:|---:|---|"]
+    for command in ("evaluate", "table1"):
+        r = data[command]
+        lines.append(f"| attitude {command} | {r['jobs']} | {r['serial_s']:.1f} | {r['distributed_s']:.1f} | "
+                     f"{r['ratio']:.2f}× | {'yes' if r['identical'] else 'no'} |")
+    write_md("bench_workers", lines + ["", "evaluate on the ten BROAD recordings, table1's twelve cells of 20 000 s; "
+                                       "each run a fresh process, start-up included."])
+
+
 def bode(refresh: bool) -> None:
     if refresh:
         for method in ("tseng", "wiener"):
@@ -196,7 +236,8 @@ def bode(refresh: bool) -> None:
 
 
 FIGURES = {"table1": table1, "spectrum": spectrum, "broad": broad, "compare": compare, "verify": verify,
-           "bench": bench, "bode": bode}
+           "bench": bench, "bench_fmu": bench_fmu, "bench_io": bench_io,
+           "bench_workers": bench_workers, "bode": bode}
 
 
 def main(argv=None) -> int:
