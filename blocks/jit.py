@@ -43,12 +43,17 @@ def sources_fingerprint(root: Path = PACKAGE_ROOT) -> str:
     return digest.hexdigest()
 
 
+def user_cache() -> Path:
+    """The project's per-user cache: $ATTITUDE_FMU_CACHE, else $XDG_CACHE_HOME/attitude_fmu,
+    else ~/.cache/attitude_fmu (RuntimeError where there is no home folder)."""
+    return Path(os.environ.get("ATTITUDE_FMU_CACHE") or Path(
+        os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "attitude_fmu")
+
+
 def cache_folder() -> Path:
     """The per-user folder of the compiled kernels of these sources."""
-    base = os.environ.get("ATTITUDE_FMU_CACHE") or Path(
-        os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "attitude_fmu"
     version = f"numba-{numba.__version__}-py{sys.version_info[0]}{sys.version_info[1]}"
-    return Path(base) / version / sources_fingerprint()[:20]
+    return user_cache() / version / sources_fingerprint()[:20]
 
 
 def _seed(folder: Path) -> None:

@@ -232,6 +232,26 @@ def test_the_c_stepping_loop_equals_the_python_one(fmu_dir, tmp_path, monkeypatc
     assert all(np.array_equal(fast[k], slow[k]) and fast[k].dtype == slow[k].dtype for k in fast)
 
 
+def test_the_c_stepping_loop_is_compiled_once_per_user_and_source(tmp_path, monkeypatch):
+    """Each process (a Dask worker, a second verify) loads the loop another compiled, from
+    the per-user cache, and leaves no folder behind; without a per-user cache (no home
+    folder) it gets a folder of its own, removed at exit."""
+    monkeypatch.setenv("ATTITUDE_FMU_CACHE", str(tmp_path / "cache"))
+    path = stepping.library_path()
+    assert path.parent == tmp_path / "cache" / "c" and not path.exists()
+    stepping.library.cache_clear()
+    assert stepping.library() is not None and path.exists()
+    built = path.stat().st_mtime_ns
+    stepping.library.cache_clear()
+    assert stepping.library() is not None and path.stat().st_mtime_ns == built  # loaded, not compiled again
+    assert sorted(p.name for p in path.parent.iterdir()) == [path.name]  # no staged file left
+    monkeypatch.setattr(stepping, "user_cache", lambda: (_ for _ in ()).throw(RuntimeError("no home folder")))
+    own = stepping.library_path().parent
+    assert own.name.startswith("attitude_stepping_")
+    shutil.rmtree(own)  # (this process ends in os._exit: tests/conftest.py)
+    stepping.library.cache_clear()
+
+
 def test_attitude_ssp_files_run_in_libcosim_and_give_the_verify_figures(fmu_dir, tmp_path, monkeypatch, capsys):
     """`attitude ssp --out DIR` writes one self-contained SSP per profile × method; libcosim
     (CosimExecution.from_ssp_file) runs it unchanged, and its figures, with its estimate two
