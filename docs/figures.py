@@ -47,6 +47,13 @@ def write_md(name: str, lines) -> None:
     (OUT / f"{name}.md").write_text("\n".join(lines) + "\n")
 
 
+def save_png(fig, name: str) -> None:
+    """fig laid out and written to docs/generated/NAME.png, then closed."""
+    fig.tight_layout()
+    fig.savefig(OUT / f"{name}.png", dpi=110)
+    pyplot().close(fig)
+
+
 def pyplot():
     import matplotlib
 
@@ -82,9 +89,7 @@ def table1(refresh: bool) -> None:
     ax.set_ylabel("simulated, degrees RMS")
     ax.set_title("Rizun's Table 1: analytic against simulated")
     ax.legend()
-    fig.tight_layout()
-    fig.savefig(OUT / "table1.png", dpi=110)
-    plt.close(fig)
+    save_png(fig, "table1")
 
 
 def spectrum(refresh: bool) -> None:
@@ -112,9 +117,7 @@ def spectrum(refresh: bool) -> None:
     ax.set_ylabel("S(ω) of a horizontal component of ĝ, (m/s²)²/(rad/s)")
     ax.set_title("Error spectrum of Rizun's filter (δn = 0.1 °/s/√Hz, δv = 1 m/s/√Hz)")
     ax.legend()
-    fig.tight_layout()
-    fig.savefig(OUT / "spectrum.png", dpi=110)
-    plt.close(fig)
+    save_png(fig, "spectrum")
 
 
 def broad(refresh: bool) -> None:
@@ -156,9 +159,7 @@ def broad(refresh: bool) -> None:
     axes[1].set_xticks(np.arange(len(names)), names)
     axes[1].set_xlabel("BROAD recording")
     axes[0].set_title("BROAD: error of each method per recording (defaults; vqf_9d and wiener use the magnetometer)")
-    fig.tight_layout()
-    fig.savefig(OUT / "broad.png", dpi=110)
-    plt.close(fig)
+    save_png(fig, "broad")
 
 
 def compare(refresh: bool) -> None:
