@@ -1,35 +1,83 @@
 """Build the project's FMUs: python build_fmu.py [--out DIR] (default dist/): the pythonfmu
-FMUs into DIR, the native estimator (in C, no Python) into DIR/native.
+FMUs into DIR, the native ones (in C, no Python) into DIR/native, the FMI 3.0 estimator into
+DIR/native/fmi3.
 
-Run from a clone, it builds from the clone's own sources (this folder is the package
-attitude_fmu); installed, it is attitude_fmu.build_fmu (python -m attitude_fmu.build_fmu).
+Run from a clone, it first builds the clone with CMake (CMakeLists.txt, in the folder build/,
+with this Python, which needs fmpy and nanobind) and installs what is built into the clone's
+folder, the package attitude_fmu: the extension module and built/ (systems.fmi.native).
+Installed, it is attitude_fmu.build_fmu (python -m attitude_fmu.build_fmu), and the package's
+build made those already.
 """
 from __future__ import annotations
 
 import argparse
 import importlib.util
+import os
+import shutil
+import subprocess
 import sys
 from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent
 
 
 def _package():
     """attitude_fmu: the package this file belongs to, or, run as a script, this clone's folder under that name."""
     if __package__:
         return sys.modules[__package__]
-    root = Path(__file__).resolve().parent
-    spec = importlib.util.spec_from_file_location("attitude_fmu", root / "__init__.py",
-                                                  submodule_search_locations=[str(root)])
+    spec = importlib.util.spec_from_file_location("attitude_fmu", ROOT / "__init__.py",
+                                                  submodule_search_locations=[str(ROOT)])
     package = importlib.util.module_from_spec(spec)
     sys.modules["attitude_fmu"] = package
     spec.loader.exec_module(package)
     return package
 
 
+def _tool(name: str) -> str | None:
+    """A build tool's command: on PATH, else beside this Python (where pip installs cmake and ninja in a
+    virtual environment)."""
+    beside = Path(sys.executable).with_name(name)
+    return shutil.which(name) or (str(beside) if beside.is_file() else None)
+
+
+def cmake_build(build_dir, targets=(), options=(), source=ROOT) -> Path:
+    """CMake's build of the clone at source in build_dir: configured first where it is not yet (with
+    this Python, Ninja where there is one, the -D options), then the targets built (every one
+    without). Raises subprocess.CalledProcessError; returns build_dir."""
+    cmake, build_dir = _tool("cmake"), Path(build_dir)
+    if cmake is None:
+        raise FileNotFoundError("building a clone needs CMake: pip install cmake ninja")
+    if not (build_dir / "CMakeCache.txt").is_file():
+        ninja = _tool("ninja")
+        generator = ["-G", "Ninja", f"-DCMAKE_MAKE_PROGRAM={ninja}"] if ninja else []
+        subprocess.run([cmake, "-S", str(source), "-B", str(build_dir), *generator,
+                        f"-DPython_EXECUTABLE={sys.executable}", *(f"-D{o}" for o in options)], check=True)
+    subprocess.run([cmake, "--build", str(build_dir), *(a for t in targets for a in ("--target", t))], check=True)
+    return build_dir
+
+
+def build_clone(build_dir=ROOT / "build") -> None:
+    """The clone built by CMake in build_dir, and what the build installs (the extension module,
+    built/) put into the clone's folder, each file replaced whole: a process may have the old one loaded."""
+    staged = Path(cmake_build(build_dir)) / "install"
+    shutil.rmtree(staged, ignore_errors=True)
+    subprocess.run([_tool("cmake"), "--install", str(build_dir), "--prefix", str(staged)], check=True)
+    for path in sorted(p for p in staged.rglob("*") if p.is_file()):
+        target = ROOT / path.relative_to(staged)
+        target.parent.mkdir(parents=True, exist_ok=True)
+        partial = target.with_name(f".{target.name}.{os.getpid()}")
+        shutil.copy2(path, partial)
+        os.replace(partial, target)
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description="Build AttitudeEstimator.fmu, ImuSensor.fmu and MotionProfile.fmu "
-                                                 "(pythonfmu) and native/AttitudeEstimator.fmu (in C, no Python).")
+                                                 "(pythonfmu), the same in C (native/) and the estimator as FMI 3.0 "
+                                                 "(native/fmi3/).")
     parser.add_argument("--out", type=Path, default=Path("dist"), help="output directory (default dist/)")
     args = parser.parse_args(argv)
+    if not __package__ and (ROOT / "CMakeLists.txt").is_file():  # a clone
+        build_clone()
     for path in _package().build_fmus(args.out):
         print(path)
     return 0

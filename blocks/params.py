@@ -1,10 +1,9 @@
 """Tuning parameters: one documented field each (name, default, unit, meaning, plausible
-range), and their validation. Every method (blocks.methods.registry) and stage
-(blocks.stages) lists its own."""
+range). blocks.tuning lists every method's and stage's; the C core validates values
+against them (blocks/core/params.h, through attitude_fmu._core.resolve_params)."""
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
 from dataclasses import dataclass
 
 
@@ -13,9 +12,10 @@ class Param:
     """One tuning parameter: name, default (None: derived), unit and meaning, and the
     plausible range of its values, low ≤ value ≤ high in the same unit; 0 only where
     allow_zero (low is then 0), every other value strictly positive. A value outside is
-    refused before any sample is taken (resolve_params); rules that depend on the sample
-    time are checked where the coefficients are made for one (blocks.methods.mahony). choices,
-where given, are the only values taken (a switch such as 0 or 1)."""
+    refused before any sample is taken (attitude_fmu._core.resolve_params); rules that
+    depend on the sample time are checked where the coefficients are made for one
+    (Mahony's gains, blocks/core/methods/mahony.h). choices, where given, are the only values
+    taken (a switch such as 0 or 1)."""
 
     name: str
     default: float | None
@@ -31,30 +31,6 @@ where given, are the only values taken (a switch such as 0 or 1)."""
         low = "0" if self.allow_zero or self.low == 0 else f"{self.low:g}"
         bracket = "[" if self.allow_zero or self.low > 0 else "("
         return f"{bracket}{low}, {self.high:g}]{_unit(self)}"
-
-
-def resolve_params(params: tuple[Param, ...], overrides: Mapping[str, float] | None, owner: str) -> dict:
-    """The defaults of params updated by overrides; unknown names, values that are not
-    finite numbers, non-positive ones (negative ones where allow_zero) and ones outside a
-    parameter's plausible range (Param.low, Param.high) are refused, naming owner."""
-    known = {p.name: p for p in params}
-    values = {p.name: p.default for p in params}
-    for name, value in (overrides or {}).items():
-        if name not in known:
-            raise ValueError(f"unknown parameter {name!r} for {owner}; known: {', '.join(known)}")
-        p = known[name]
-        number = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
-        if not (number and (value >= 0 if p.allow_zero else value > 0)):
-            kind = "non-negative" if p.allow_zero else "positive"
-            raise ValueError(f"parameter {name} must be a finite {kind} number ({p.range_text()}), got {value!r}")
-        if p.choices is not None and value not in p.choices:
-            raise ValueError(f"parameter {name} must be {' or '.join(f'{c:g}' for c in p.choices)}, got {value!r} "
-                             f"({p.doc})")
-        if not p.low <= value <= p.high:
-            raise ValueError(f"parameter {name} = {value:g}{_unit(p)} is outside its plausible range "
-                             f"{p.range_text()} ({p.doc})")
-        values[name] = float(value)
-    return values
 
 
 def _unit(p: Param) -> str:

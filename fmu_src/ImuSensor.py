@@ -54,7 +54,10 @@ class ImuSensor(ProjectSlave):
         signals = np.array([self.omega_x, self.omega_y, self.omega_z, self.f_x, self.f_y, self.f_z])
         if self.model.latency:
             if self.delay is None:
-                self.delay, self.step_size = self.model.delay_state(1.0 / step_size, signals), step_size
+                try:
+                    self.delay, self.step_size = self.model.delay_state(1.0 / step_size, signals), step_size
+                except ValueError as exc:  # a latency longer than the delay line holds
+                    return self.fail(str(exc))
             elif not same_step(step_size, self.step_size):
                 return self.fail(f"latency needs a fixed step: got {step_size!r} s after {self.step_size!r} s")
             self.delay, signals = self.model.delay_step(self.delay, signals, 1.0 / self.step_size)

@@ -6,11 +6,9 @@ named <profile>_<parameter> and start at the profile's defaults.
 """
 from __future__ import annotations
 
-from scipy.spatial.transform import Rotation
-
 from attitude_fmu.fmu_src.fmu_support import ProjectSlave
 from attitude_fmu.fmu_src.simulation_variables import motion_profile
-from attitude_fmu.systems.simulation.motion import EARTH_FIELD_UT, profile
+from attitude_fmu.systems.simulation.motion import earth_field, profile
 
 
 class MotionProfile(ProjectSlave):
@@ -28,8 +26,6 @@ class MotionProfile(ProjectSlave):
             prof = profile(self.profile)
             motion = prof.motion({p.name: getattr(self, f"{prof.name}_{p.name}") for p in prof.params}, g=self.g)
             self.stream = motion.stream(self.seed)
-            # a closed-form motion leaves no state when stepped (and pickle cannot hold its functions)
-            self.internal_state = () if self.stream is motion else ("stream",)
         except ValueError as exc:
             self.fail(f"invalid parameter: {exc}")
 
@@ -40,6 +36,5 @@ class MotionProfile(ProjectSlave):
         self.omega_x, self.omega_y, self.omega_z = (float(v) for v in gyr)
         self.f_x, self.f_y, self.f_z = (float(v) for v in f)
         self.qt_w, self.qt_x, self.qt_y, self.qt_z = (float(v) for v in q)
-        m = Rotation.from_quat(q, scalar_first=True).inv().apply(EARTH_FIELD_UT)
-        self.m_x, self.m_y, self.m_z = (float(v) for v in m)
+        self.m_x, self.m_y, self.m_z = (float(v) for v in earth_field(q))
         return True

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import copy
 import hashlib
+import importlib.machinery
 import importlib.util
 import pickle
 import sys
@@ -63,17 +64,20 @@ def _origin(module: str) -> Path | None:
 def foreign_code(resources) -> str | None:
     """Why an FMU whose resources folder is resources cannot run in this process, or None.
 
-    An FMU carries the modules of attitude_fmu it imports, as packages without an
-    __init__.py (namespace packages), so that FMUs of one build loaded into one process
-    (each carrying its own part) share one package. Python keeps one copy of a module per
-    process: if a module was imported from other sources (an FMU of another build, an
-    installed attitude_fmu of another version), this FMU would run that code; it is
-    refused instead."""
+    An FMU carries the modules of attitude_fmu it imports (sources, and the extension
+    module's library), as packages without an __init__.py (namespace packages), so that
+    FMUs of one build loaded into one process (each carrying its own part) share one
+    package. Python keeps one copy of a module per process: if a module was imported from
+    other sources (an FMU of another build, an installed attitude_fmu of another version),
+    this FMU would run that code; it is refused instead."""
     if resources is None:
         return None
     own_root = Path(resources) / PACKAGE
-    for path in sorted(own_root.rglob("*.py")):
-        module = ".".join((PACKAGE, *path.relative_to(own_root).with_suffix("").parts))
+    for path in sorted(own_root.rglob("*")):
+        suffix = next((s for s in (".py", *importlib.machinery.EXTENSION_SUFFIXES) if path.name.endswith(s)), None)
+        if suffix is None:
+            continue
+        module = ".".join((PACKAGE, *path.relative_to(own_root).parent.parts, path.name[: -len(suffix)]))
         origin = _origin(module)
         if origin is None or origin == path.resolve():
             continue

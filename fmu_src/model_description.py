@@ -1,13 +1,14 @@
-"""FMI 2.0 model descriptions written from a table of variables (fmu_src.variables): the
+"""Model descriptions written from a table of variables (fmu_src.variables): the FMI 2.0
 UnitDefinitions, ModelVariables and ModelStructure of every FMU the project builds
 (pythonfmu's through fmu_support.ProjectSlave.to_xml), and the whole document of a native
-one (model_description)."""
+one, FMI 2.0 (model_description) or 3.0 (model_description3; fmu_src/generate.py writes them).
+Only the standard library is imported: the build runs it."""
 from __future__ import annotations
 
 import math
 from xml.etree.ElementTree import Element, SubElement
 
-from attitude_fmu.fmu_src.variables import BOOLEAN, OUT, REAL, UNITS
+from attitude_fmu.fmu_src.variables import BOOLEAN, INTEGER, OUT, REAL, STRING, UNITS, Variable
 
 # the categories the native FMUs log in: pythonfmu's (the status of a message) and a trace of
 # the FMI calls, for debug logging
@@ -69,7 +70,7 @@ def model_description(name: str, description: str, guid: str, variables, generat
                       source_files=()) -> Element:
     """The modelDescription.xml of an FMI 2.0 co-simulation FMU in C whose binary is named
     name (its model identifier): the variables of the table, the capabilities of the
-    project's FMI plumbing (fmu_src/native/fmi2), its sources (paths under sources/)."""
+    project's FMI plumbing (fmu_src/fmi2), its sources (paths under sources/)."""
     root = Element("fmiModelDescription", {
         "fmiVersion": "2.0", "modelName": name, "guid": guid, "description": description, "author": "attitude-fmu",
         "generationTool": generation_tool, "variableNamingConvention": "structured"})
@@ -88,4 +89,58 @@ def model_description(name: str, description: str, guid: str, variables, generat
         SubElement(categories, "Category", name=category, description=text)
     root.append(model_variables(variables))
     root.append(model_structure(variables))
+    return root
+
+
+FMI3_TYPES = {REAL: "Float64", INTEGER: "Int32"}  # the table's types that FMI 3.0 names otherwise
+
+
+def time_variable(variables) -> Variable:
+    """FMI 3.0's independent variable, after the table's variables."""
+    return Variable("time", REAL, "independent", "continuous", 0.0, "simulation time", len(variables), "s")
+
+
+def model_variables3(variables) -> Element:
+    """FMI 3.0's ModelVariables of the table: Real as Float64, Integer as Int32, Boolean and String
+    as themselves, with the same names, value references, causalities, units and start values,
+    and `time` after them."""
+    node = Element("ModelVariables")
+    for v in (*variables, time_variable(variables)):
+        attributes = {"name": v.name, "valueReference": str(v.value_reference), "description": v.description,
+                      "causality": v.causality, "variability": v.variability}
+        if v.initial is not None:
+            attributes["initial"] = v.initial
+        if v.type != STRING and v.causality != "independent":
+            attributes["start"] = start_text(v)
+        if v.unit is not None:
+            attributes["unit"] = v.unit
+        typed = SubElement(node, FMI3_TYPES.get(v.type, v.type), attributes)
+        if v.type == STRING:
+            SubElement(typed, "Start", value=start_text(v))
+    return node
+
+
+def model_description3(name: str, description: str, instantiation_token: str, variables,
+                       generation_tool: str) -> Element:
+    """The modelDescription.xml of an FMI 3.0 co-simulation FMU in C whose binary is named name,
+    with the capabilities of fmu_src/fmi3."""
+    root = Element("fmiModelDescription", {
+        "fmiVersion": "3.0", "modelName": name, "instantiationToken": instantiation_token,
+        "description": description, "author": "attitude-fmu", "generationTool": generation_tool,
+        "variableNamingConvention": "structured"})
+    SubElement(root, "CoSimulation", {
+        "modelIdentifier": name, "needsExecutionTool": "false", "canBeInstantiatedOnlyOncePerProcess": "false",
+        "canGetAndSetFMUState": "true", "canSerializeFMUState": "true", "providesDirectionalDerivatives": "false",
+        "providesAdjointDerivatives": "false", "canHandleVariableCommunicationStepSize": "true",
+        "maxOutputDerivativeOrder": "0", "providesIntermediateUpdate": "false",
+        "canReturnEarlyAfterIntermediateUpdate": "false", "hasEventMode": "false"})
+    root.append(unit_definitions([*variables, time_variable(variables)]))
+    categories = SubElement(root, "LogCategories")
+    for category, text in LOG_CATEGORIES.items():
+        SubElement(categories, "Category", name=category, description=text)
+    root.append(model_variables3(variables))
+    structure = SubElement(root, "ModelStructure")
+    for v in variables:
+        if v.causality == OUT:
+            SubElement(structure, "Output", valueReference=str(v.value_reference))
     return root

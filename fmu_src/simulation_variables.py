@@ -1,13 +1,14 @@
 """The interfaces of the simulation's FMUs, ImuSensor and MotionProfile: tables of FMU variables
 (fmu_src.variables.Table), from which the pythonfmu FMU registers its variables and the native
-one's modelDescription.xml and C header are written (systems.fmi.native), so one can take the
-other's place in an SSP. fmu_src/ImuSensor.py and fmu_src/MotionProfile.py say what each step does."""
+one's modelDescription.xml and C header are written (fmu_src/generate.py, by the build), so one
+can take the other's place in an SSP. fmu_src/ImuSensor.py and fmu_src/MotionProfile.py say what
+each step does. Only the standard library is imported (and systems/simulation/profile_table.py)."""
 from __future__ import annotations
 
 from functools import cache
 
 from attitude_fmu.fmu_src.variables import IN, INTEGER, OUT, PAR, Table, Variable, fmi_unit
-from attitude_fmu.systems.simulation.motion import EARTH_FIELD_UT, PROFILES
+from attitude_fmu.systems.simulation.profile_table import EARTH_FIELD_UT, PROFILES
 
 
 @cache
@@ -46,7 +47,7 @@ def motion_profile() -> tuple[Variable, ...]:
     t.parameter("profile", "human", f"motion profile: {', '.join(PROFILES)}")
     t.parameter("seed", 0, "seed of random profiles (systems.simulation.noise)", INTEGER)
     t.real("g", 9.81, "m/s2", "magnitude of gravity", PAR)
-    for prof in PROFILES.values():
-        for p in prof.params:
-            t.real(f"{prof.name}_{p.name}", p.default, fmi_unit(p.unit), f"{prof.name}: {p.doc}", PAR)
+    for name, (_, params) in PROFILES.items():
+        for p in params:
+            t.real(f"{name}_{p.name}", p.default, fmi_unit(p.unit), f"{name}: {p.doc}", PAR)
     return tuple(t)

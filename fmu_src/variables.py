@@ -4,8 +4,9 @@ variability, initial, unit, start value, description, value reference).
 Every model description of an interface is written from its table
 (fmu_src.model_description): the pythonfmu FMU registers its variables from it
 (fmu_support.ProjectSlave), the native FMU's modelDescription.xml and C header are
-generated from it (systems.fmi.native). So one FMU can take the other's place in an SSP or
-a master's script: same names, causalities, units, start values and value references.
+generated from it by the build (fmu_src/generate.py). So one FMU can take the other's place
+in an SSP or a master's script: same names, causalities, units, start values and value
+references. Only the standard library is imported (and blocks/tuning.py): the build runs it.
 """
 from __future__ import annotations
 
@@ -13,8 +14,7 @@ import math
 from dataclasses import dataclass
 from functools import cache
 
-from attitude_fmu.blocks.methods.registry import METHODS
-from attitude_fmu.blocks.pipeline.causal import ESTIMATORS
+from attitude_fmu.blocks.tuning import METHODS, uses
 
 REAL, INTEGER, BOOLEAN, STRING = "Real", "Integer", "Boolean", "String"
 IN, OUT, PAR = "input", "output", "parameter"
@@ -106,21 +106,17 @@ def tuning_parameters() -> dict:
     """Every method's tuning parameters and those of the gyro-offset and heading
     estimators, once each: name → (FMI unit, description, start value). The start value is
     the default where every stage with the name has that one default, else NaN: unset."""
-    found = {}
-    for owner, stage in (*((f"method {m.name}", m.params) for m in METHODS.values()), *ESTIMATORS.items()):
-        for p in stage:
-            found.setdefault(p.name, []).append((owner, p))
     params = {}
-    for name, uses in found.items():
-        first = uses[0][1]
-        defaults = {p.default for _, p in uses}
+    for name, stages in uses().items():
+        first = stages[0][1]
+        defaults = {p.default for _, p in stages}
         if len(defaults) == 1 and first.default is not None:
             params[name] = (fmi_unit(first.unit), f"{first.doc}; default {first.default:g}", first.default)
             continue
         if defaults == {None}:
             doc = f"{first.doc}; NaN (the start value): unset"
         else:
-            each = "; ".join(f"{owner}: {'unset' if p.default is None else format(p.default, 'g')}" for owner, p in uses)
+            each = "; ".join(f"{owner}: {'unset' if p.default is None else format(p.default, 'g')}" for owner, p in stages)
             doc = f"{first.doc}; NaN (the start value): the default of the stage that runs ({each})"
         params[name] = (fmi_unit(first.unit), doc, math.nan)
     return params

@@ -21,7 +21,8 @@ FILES = sorted(BROAD.glob("*.mat"))
 DISTURBED_MAGNETIC = ("28_disturbed_stationary_magnet_A", "32_disturbed_attached_magnet_1cm")
 VQF_TAU_ACC = 3.0  # s, vqf's default accelerometer time constant
 
-pytestmark = pytest.mark.skipif(not FILES, reason=f"no BROAD recordings in {BROAD}")
+pytestmark = [pytest.mark.slow,  # every BROAD recording, every estimator and peer: a long table run
+              pytest.mark.skipif(not FILES, reason=f"no BROAD recordings in {BROAD}")]
 
 
 @pytest.fixture(scope="module")

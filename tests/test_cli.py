@@ -8,10 +8,10 @@ import sys
 import numpy as np
 import pytest
 from scipy.io import savemat
+from scipy.spatial.transform import Rotation
 
 from attitude_fmu.blocks.methods.registry import METHODS
 from attitude_fmu.blocks.pipeline.batch import estimate
-from attitude_fmu.blocks.quaternion import quat_euler_zyx
 from attitude_fmu.systems.cli.commands import main
 from attitude_fmu.systems.recordings.writing import EULER_COLUMNS, OUTPUT_COLUMNS
 from attitude_fmu.systems.simulation.motion import HumanMotion
@@ -64,8 +64,8 @@ def test_estimate_csv_writes_the_contracted_columns_equal_to_the_batch_path(tmp_
 
 
 def test_euler_adds_the_angles_of_the_fmus_outputs(tmp_path, imu):
-    """--euler appends roll, pitch, yaw in degrees, those the AttitudeEstimator FMU outputs
-    (blocks.quaternion.quat_euler_zyx) of the same quaternions; the other columns stay."""
+    """--euler appends roll, pitch, yaw in degrees, those the AttitudeEstimator FMU outputs: the
+    Z-Y-X angles of the same quaternions (scipy's as_euler("ZYX"), reversed); the other columns stay."""
     gyr, acc = imu
     _write_csv(tmp_path / "in.csv", _imu_columns(gyr, acc))
     outputs = {}
@@ -75,7 +75,7 @@ def test_euler_adds_the_angles_of_the_fmus_outputs(tmp_path, imu):
     header, data = outputs[True]
     assert header == [*OUTPUT_COLUMNS, *EULER_COLUMNS]
     assert np.array_equal(data[:, :len(OUTPUT_COLUMNS)], outputs[False][1])
-    fmu_angles = np.degrees([quat_euler_zyx(q / np.linalg.norm(q)) for q in data[:, 1:5]])
+    fmu_angles = Rotation.from_quat(data[:, 1:5], scalar_first=True).as_euler("ZYX", degrees=True)[:, ::-1]
     assert np.abs(data[:, len(OUTPUT_COLUMNS):] - fmu_angles).max() < 1e-6
     assert np.ptp(data[:, -3:], axis=0).min() > 5.0  # the motion turns every angle
 
@@ -322,6 +322,7 @@ def test_console_entry_point_reports_errors_without_traceback(tmp_path):
     assert "no such file" in proc.stderr and "Traceback" not in proc.stderr
 
 
+@pytest.mark.slow  # the whole of Table 1 simulated (its first row: tests/test_paper.py)
 def test_table1_json_every_cell_within_7_percent(capsys):
     assert main(["table1", "--json"]) == 0
     rows = json.loads(capsys.readouterr().out)

@@ -22,8 +22,9 @@ from attitude_fmu.systems.cli.commands import main
 from attitude_fmu.systems.cluster.jobs import Jobs
 from attitude_fmu.systems.evaluation.evaluate import METRICS, evaluate
 from attitude_fmu.systems.evaluation.sweep import TUNING_WARNING
-from attitude_fmu.systems.simulation.motion import ClosedFormMotion
 from attitude_fmu.systems.simulation.sensor_model import ImuModel
+from tests import native
+from tests.motions import ClosedFormMotion
 
 FS = 100.0
 GRID = ["--grid", "delta_n=0.001,0.003", "--grid", "scale_error=0.002,0.01"]
@@ -37,8 +38,8 @@ def _recording(path, seed: int, duration: float = 40.0):
     """A BROAD-like .mat: slow turns about two axes (the rates set by seed), a MEMS gyro and
     accelerometer, the earth's field, a reference with a gap, movement from 5 s."""
     rates = 0.2 + 0.3 * np.random.default_rng(seed).random(2)
-    turns = ClosedFormMotion("turns", lambda t: Rotation.from_euler("ZY", np.column_stack([
-        0.8 * np.sin(rates[0] * t), 0.5 * np.sin(rates[1] * t)])), lambda t: np.zeros((len(t), 3)))
+    turns = ClosedFormMotion(lambda t: Rotation.from_euler("ZY", np.column_stack([
+        0.8 * np.sin(rates[0] * t), 0.5 * np.sin(rates[1] * t)])))
     motion = turns.generate(duration, FS)
     gyr, acc = ImuModel(delta_n=math.radians(0.02), acc_noise=0.002).apply(motion, seed=seed)
     ref = motion.quat.copy()
@@ -149,9 +150,6 @@ def test_a_worker_killed_mid_run_loses_no_result(recordings):
     assert outcome == serial and "failed" not in outcome and len(outcome["recordings"]) == len(files)
 
 
-CRASH_AT_EXIT = "#include <stdlib.h>\n__attribute__((destructor)) static void crash_at_exit(void) { abort(); }\n"
-
-
 def _load_and_step(fmu, library):
     """A job: the library whose destructor aborts, and AttitudeEstimator.fmu stepped 50 times
     at rest; the up-vector it ends on."""
@@ -165,23 +163,17 @@ def _load_and_step(fmu, library):
     return out[-1].tolist()
 
 
-def test_a_worker_that_ran_fmus_ends_with_status_0_where_exit_would_crash_it(tmp_path, monkeypatch):
-    """A library whose destructor aborts at exit() (as pythonfmu's can crash a process at
-    interpreter shutdown) kills a process that loads it and exits. On a cluster of others
-    (--scheduler), worker processes that load it and an FMU end by systems.cluster.worker_exit
-    with status 0, their results in."""
+def test_a_worker_that_ran_fmus_ends_with_status_0_where_exit_would_crash_it(fmu_dir, monkeypatch):
+    """A library whose destructor aborts at exit() (tests/crash_at_exit.c, as pythonfmu's can
+    crash a process at interpreter shutdown) kills a process that loads it and exits. On a
+    cluster of others (--scheduler), worker processes that load it and an FMU end by
+    systems.cluster.worker_exit with status 0, their results in."""
     from distributed import LocalCluster
     from distributed.nanny import WorkerProcess
 
-    from attitude_fmu.systems.fmi.build import build_fmus
-
-    source = tmp_path / "crash.c"
-    source.write_text(CRASH_AT_EXIT)
-    library = tmp_path / "libcrash.so"
-    subprocess.run(["gcc", "-shared", "-fPIC", "-o", str(library), str(source)], check=True)
+    library = native.build(["crash_at_exit"]) / "tests" / "crash_at_exit.so"
     alone = subprocess.run([sys.executable, "-c", f"import ctypes; ctypes.CDLL({str(library)!r})"])
     assert alone.returncode == -signal.SIGABRT
-    build_fmus(tmp_path / "dist", ("AttitudeEstimator",))
     statuses = []
     stopped = WorkerProcess.mark_stopped
 
@@ -193,7 +185,7 @@ def test_a_worker_that_ran_fmus_ends_with_status_0_where_exit_would_crash_it(tmp
     monkeypatch.setattr(WorkerProcess, "mark_stopped", record)
     with LocalCluster(n_workers=2, threads_per_worker=1, dashboard_address="127.0.0.1:0") as cluster:
         with Jobs(scheduler=cluster.scheduler_address, bar=False) as jobs:
-            job = (str(tmp_path / "dist" / "AttitudeEstimator.fmu"), str(library))
+            job = (str(fmu_dir / "AttitudeEstimator.fmu"), str(library))
             results = jobs.map(_load_and_step, [job, job], ["a", "b"])
     assert np.allclose(results, [[0.0, 0.0, 1.0]] * 2, atol=1e-9), results
     assert statuses == [0, 0], statuses

@@ -1,4 +1,5 @@
 """The FMUs: validation, equality with the batch path, FMI robustness, the SSP diagram, other importers."""
+import importlib.machinery
 import importlib.util
 import json
 import math
@@ -26,9 +27,8 @@ from attitude_fmu.blocks.stages.timing import STEP_TOLERANCE
 from attitude_fmu.systems.fmi.build import (
     FINGERPRINT,
     FMU_NAMES,
-    build_fmus,
     built_from,
-    compile_guard,
+    guard_binary,
     ensure_built,
     python_environment,
     source_fingerprint,
@@ -37,18 +37,12 @@ from attitude_fmu.systems.fmi.cosim import FmuRunner, cosimulate, cosimulate_lib
 from attitude_fmu.systems.fmi.ssp import write_ssp
 from attitude_fmu.systems.simulation.motion import HumanMotion, profile
 from attitude_fmu.systems.simulation.sensor_model import ImuModel
+from tests import native as c_build
 from tests.test_real_data import _turns_with_field
 
 INPUTS = [f"{s}_{a}" for s in ("gyr", "acc") for a in "xyz"]
 OUTPUTS = ["q_w", "q_x", "q_y", "q_z", "g_x", "g_y", "g_z"]
 FS = 100.0
-
-
-@pytest.fixture(scope="module")
-def fmu_dir(tmp_path_factory):
-    out = tmp_path_factory.mktemp("fmus")
-    build_fmus(out)
-    return out
 
 
 @pytest.fixture(scope="module")
@@ -123,12 +117,14 @@ def test_parameters_start_at_their_defaults_and_an_importer_may_set_every_start_
 
 @pytest.mark.parametrize("name", FMU_NAMES)
 def test_each_fmu_carries_exactly_the_modules_its_adapter_imports(fmu_dir, tmp_path, name):
-    """The zip's Python files under resources/attitude_fmu are the modules a fresh
-    interpreter loads when it imports the FMU's adapter from there alone (the installed
-    attitude_fmu out of reach): no command line, plots, benchmarks or build code."""
+    """The zip's modules under resources/attitude_fmu (Python files and the compiled extension
+    attitude_fmu._core) are those a fresh interpreter loads when it imports the FMU's adapter
+    from there alone (the installed attitude_fmu out of reach): no command line, plots,
+    benchmarks or build code."""
+    suffixes = (".py", *importlib.machinery.EXTENSION_SUFFIXES)
     with zipfile.ZipFile(fmu_dir / f"{name}.fmu") as zf:
         carried = sorted(n.removeprefix("resources/") for n in zf.namelist()
-                         if n.startswith("resources/attitude_fmu/") and n.endswith(".py"))
+                         if n.startswith("resources/attitude_fmu/") and n.endswith(suffixes))
         zf.extractall(tmp_path)
     script = textwrap.dedent(f"""
         import importlib.machinery, importlib.util, json, sys
@@ -144,6 +140,7 @@ def test_each_fmu_carries_exactly_the_modules_its_adapter_imports(fmu_dir, tmp_p
     proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr[-3000:]
     assert json.loads(proc.stdout) == carried
+    assert [f for f in carried if not f.endswith(".py")] == [f"attitude_fmu/_core{importlib.machinery.EXTENSION_SUFFIXES[0]}"]
     assert not [f for f in carried if f.split("/")[1] == "systems" and f.split("/")[2] != "simulation"]
 
 
@@ -580,9 +577,11 @@ def test_fmpy_simulate_ssp_runs_the_same_diagram_one_step_per_connection_later(f
     assert np.abs(q_theirs[2:n] - q_ours[: n - 2]).max() < 1e-12
 
 
+@pytest.mark.slow
 def test_fmu_runs_in_a_fresh_environment_without_the_project(fmu_dir, recording, tmp_path):
-    """A virtual environment with numpy, scipy, control, pythonfmu and fmpy only (no numba,
-    not this project): the FMU's resources carry the code, and it gives the batch numbers."""
+    """A virtual environment with numpy, scipy, control, pythonfmu and fmpy only (not this
+    project): the FMU's resources carry the code (the compiled extension attitude_fmu._core
+    among it), and it gives the batch numbers."""
     venv = tmp_path / "venv"
     subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True)
     python = venv / "bin" / "python"
@@ -625,29 +624,21 @@ def test_fmu_runs_in_a_fresh_environment_without_the_project(fmu_dir, recording,
     assert np.abs(out[:, 4:] - ref.up).max() < 1e-9
 
 
-def test_fmu_runs_in_an_importer_without_python(fmu_dir, tmp_path, monkeypatch):
+@pytest.mark.slow
+def test_fmu_runs_in_an_importer_without_python(fmu_dir, tmp_path):
     """Most FMI tools are C or C++ programs with no Python in their process, where
     pythonfmu's library cannot load (undefined Python symbols). The FMU's binary loads the
     libpython it was built with and starts the interpreter with the build environment's
     packages (fmu_build.python_environment); a C importer (tests/fmi_host.c) then gets the
     estimate blocks.pipeline.online computes from the same inputs, and fmi2Error for the
     calls FMI 2.0 does not allow. The importer and the FMU's binary (fmi2_guard.c) are
-    built with -fsanitize=address,undefined, and no sanitizer reports anything."""
+    built with -fsanitize=address,undefined (tests/native.py), and no sanitizer reports anything."""
     from fmpy import extract, read_model_description
 
-    cc = os.environ.get("CC") or "cc"
-    if shutil.which(cc.split()[0]) is None:
-        pytest.skip("no C compiler")
     if not any(python_environment().splitlines()[:2]):
         pytest.skip("this Python has no shared libpython to start in another process")
-    flags = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-fsanitize=address,undefined", "-fno-omit-frame-pointer"]
-    host = tmp_path / "fmi_host"
-    subprocess.run([*cc.split(), *flags, "-o", str(host), os.path.join(os.path.dirname(__file__), "fmi_host.c"),
-                    "-ldl"], check=True)
-    monkeypatch.setenv("CC", " ".join([cc, *flags]))
-    said = []
-    guard = compile_guard(tmp_path / "guard.so", log=said.append)
-    assert guard is not None, said
+    folder = c_build.build(["fmi_host", "fmi2_guard"], sanitize=True)
+    host, guard = folder / "tests" / "fmi_host", folder / "built" / "fmi2_guard.so"
     fmu = tmp_path / "AttitudeEstimator.fmu"  # the built FMU with the sanitized guard as its binary
     binary = "binaries/linux64/AttitudeEstimator.so"
     with zipfile.ZipFile(fmu_dir / "AttitudeEstimator.fmu") as src, zipfile.ZipFile(fmu, "w") as dst:
@@ -695,13 +686,14 @@ def test_verify_cli_json_contract_and_exit_status(fmu_dir, monkeypatch, capsys):
     assert "too short" in capsys.readouterr().err
 
 
-def test_without_a_c_compiler_the_build_warns_and_keeps_pythonfmus_binary(tmp_path, monkeypatch):
-    from attitude_fmu.systems.fmi.build import compile_guard
+def test_without_the_built_guard_the_fmus_keep_pythonfmus_binary_and_a_warning_says_what_that_costs(tmp_path,
+                                                                                                   monkeypatch):
+    from attitude_fmu.systems.fmi import native
 
-    monkeypatch.setenv("CC", str(tmp_path / "no-such-cc"))
+    monkeypatch.setattr(native, "BUILT", tmp_path / "nothing built")
     said = []
-    assert compile_guard(tmp_path / "guard.so", log=said.append) is None
-    assert "cannot compile fmi2_guard.c" in said[0] and "fmi2Discard instead of fmi2Error" in said[0]
+    assert guard_binary(log=said.append) is None
+    assert "fmi2_guard.so is not built" in said[0] and "fmi2Discard instead of fmi2Error" in said[0]
 
 
 def test_guard_reports_a_missing_pythonfmu_library_instead_of_crashing(fmu_dir, tmp_path, capsys):
@@ -812,6 +804,7 @@ def test_a_second_run_after_the_importer_deleted_the_first_fmus_folders(fmu_dir,
     assert not Path(loaded).exists() or Path(loaded).is_relative_to(installed), loaded
 
 
+@pytest.mark.slow  # 300 s under two masters
 def test_libcosim_and_our_master_hold_the_human_row_of_verify_to_its_bound(fmu_dir, tmp_path):
     """attitude verify's human × wiener configuration, 300 s, under both masters: the
     inclination error against the closed-form truth (libcosim's estimate two steps late,

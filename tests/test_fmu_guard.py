@@ -1,22 +1,15 @@
 """The pythonfmu FMUs' guard (fmu_src/fmi2_guard.c) against calls FMI 2.0 does not allow
-(under the sanitizers: tests/test_fmu.py's importer without Python); and the compiled
-kernels a fresh extraction of the same FMU finds in the per-user cache (blocks.jit)."""
+(under the sanitizers: tests/test_fmu.py's importer without Python)."""
 import math
-import os
-import subprocess
-import sys
-import textwrap
-from pathlib import Path
 
 import numpy as np
-from fmpy import extract
 from fmpy.fmi1 import FMICallException
 
 from attitude_fmu.blocks.pipeline.batch import estimate
 from attitude_fmu.systems.fmi.cosim import FmuRunner
 from attitude_fmu.systems.simulation.motion import HumanMotion
 from attitude_fmu.systems.simulation.sensor_model import ImuModel
-from tests.test_fmu import FS, INPUTS, OUTPUTS, fmu_dir  # noqa: F401 (fmu_dir: the FMUs, built once here)
+from tests.test_fmu import FS, INPUTS, OUTPUTS
 
 
 def test_calls_in_the_wrong_phase_or_on_the_wrong_type_end_in_fmi2_error_and_harm_nothing(fmu_dir, capsys):
@@ -65,54 +58,3 @@ def test_calls_in_the_wrong_phase_or_on_the_wrong_type_end_in_fmi2_error_and_har
     again, _ = runner.run(np.hstack([gyr, acc]), 1 / FS)
     runner.close()
     assert np.array_equal(again, out)
-
-
-def test_a_fresh_extraction_finds_the_kernels_another_extraction_compiled(fmu_dir, tmp_path):
-    """Two extractions of one FMU in two processes, one per-user cache (ATTITUDE_FMU_CACHE):
-    the second loads every kernel the first compiled and compiles none."""
-    fmu = str(fmu_dir / "AttitudeEstimator.fmu")
-    script = textwrap.dedent("""
-        import sys, types
-        package = types.ModuleType("attitude_fmu")  # the extraction's copy, whatever else is installed
-        package.__path__ = [sys.argv[1] + "/attitude_fmu"]
-        sys.modules["attitude_fmu"] = package
-        import numpy as np
-        from attitude_fmu.blocks.quaternion import integrate_rates
-        assert integrate_rates.py_func.__code__.co_filename.startswith(sys.argv[1])
-        quat = np.empty((5, 4))
-        integrate_rates(np.full((5, 3), 0.1), 0.01, quat)
-        print(quat[-1].tolist())
-    """)
-    env = {**os.environ, "ATTITUDE_FMU_CACHE": str(tmp_path / "cache"), "NUMBA_DEBUG_CACHE": "1"}
-    env.pop("NUMBA_CACHE_DIR", None)
-    runs = []
-    for k in range(2):
-        resources = Path(extract(fmu, unzipdir=str(tmp_path / f"x{k}"))) / "resources"
-        runs.append(subprocess.run([sys.executable, "-c", script, str(resources)], capture_output=True, text=True,
-                                   env=env, cwd=tmp_path, timeout=600))
-        assert runs[-1].returncode == 0, runs[-1].stderr[-2000:]
-    first, second = (run.stdout for run in runs)
-    assert "data saved to" in first and "[cache] data loaded from" in second, second
-    assert "data saved to" not in second and str(tmp_path / "cache") in second
-    assert first.splitlines()[-1] == second.splitlines()[-1]
-
-
-def test_the_kernels_compiled_at_the_build_seed_a_per_user_folder_that_has_none(tmp_path, monkeypatch):
-    """blocks.jit._seed: a cache folder that does not exist starts as a copy of the
-    package's kernel_cache/ (setup.py compiles it at the build); one that exists is left
-    as it is."""
-    from attitude_fmu.blocks import jit
-
-    package = tmp_path / "attitude_fmu"
-    shipped = package / jit.SHIPPED / "numba-x-py3" / "fingerprint" / "blocks"
-    shipped.mkdir(parents=True)
-    (shipped / "kernel.nbi").write_bytes(b"index")
-    monkeypatch.setattr(jit, "PACKAGE_ROOT", package)
-    folder = tmp_path / "user" / "numba-x-py3" / "fingerprint"
-    folder.parent.mkdir(parents=True)
-    jit._seed(folder)
-    assert (folder / "blocks" / "kernel.nbi").read_bytes() == b"index"
-    (shipped / "kernel.nbi").write_bytes(b"newer")
-    jit._seed(folder)
-    assert (folder / "blocks" / "kernel.nbi").read_bytes() == b"index"
-    assert sorted(p.name for p in folder.parent.iterdir()) == ["fingerprint"]  # no staging folder left

@@ -10,8 +10,8 @@ from attitude_fmu.blocks.errors import quaternion_errors
 from attitude_fmu.blocks.pipeline.batch import estimate
 from attitude_fmu.blocks.stages.delays import mag_delay
 from attitude_fmu.blocks.stages.mag_delay import MAG_DELAY_MIN_S
-from attitude_fmu.systems.simulation.motion import ClosedFormMotion
 from attitude_fmu.systems.simulation.sensor_model import ImuModel
+from tests.motions import ClosedFormMotion
 
 FS = 200.0
 DELAY_STEPS = 6  # 30 ms at FS
@@ -36,7 +36,7 @@ def _fast_turns(duration=120.0, hard_iron=HARD_IRON_UT):
     gyro see it, at a third of FS; see _field)."""
     def angles(t):
         return np.column_stack([1.5 * np.sin(2.0 * t), 0.6 * np.sin(5.0 * t), 0.5 * np.sin(6.0 * t)])
-    turns = ClosedFormMotion("turns", lambda t: Rotation.from_euler("ZYX", angles(t)), lambda t: np.zeros((len(t), 3)))
+    turns = ClosedFormMotion(lambda t: Rotation.from_euler("ZYX", angles(t)))
     motion = turns.generate(duration, FS)
     gyr, acc = ImuModel(delta_n=math.radians(0.05)).apply(motion, seed=1)
     return (motion, gyr, acc, _field(motion.mag, 0, hard_iron=hard_iron),

@@ -1,24 +1,20 @@
 """Motions, sensor model and the closed-loop diagram against exact truth."""
 import math
 
+import control
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from attitude_fmu import profile
 from attitude_fmu.blocks.errors import inclination_error
 from attitude_fmu.blocks.pipeline.batch import estimate
 from attitude_fmu.blocks.stages import gyro_offset
 from attitude_fmu.blocks.stages.heading import with_magnetometer
 from attitude_fmu.blocks.stages.timing import carry_forward_rows
 from attitude_fmu.systems.simulation.diagram import simulate_closed_loop
-from attitude_fmu.systems.simulation.motion import (
-    EARTH_FIELD_UT,
-    PROFILES,
-    HumanMotion,
-    _human_run,
-    incline_oscillation,
-    steady_lever_arm,
-)
+from attitude_fmu.systems.simulation.motion import EARTH_FIELD_UT, PROFILES, HumanMotion
+from attitude_fmu.systems.simulation.noise import MOTION, SENSOR, normals
 from attitude_fmu.systems.simulation.sensor_model import ImuModel
 
 
@@ -60,7 +56,7 @@ def test_sensor_model_scale_and_misalignment():
 
 
 def test_steady_lever_arm_closed_form():
-    m = steady_lever_arm(2.0, 0.2, g=9.81).generate(10.0, 100.0)
+    m = profile("lever_arm").motion({"rate": 2.0, "radius": 0.2}, g=9.81).generate(10.0, 100.0)
     rot = Rotation.from_quat(m.quat, scalar_first=True)
     assert np.abs((rot[:-1].inv() * rot[1:]).as_rotvec() - m.gyr[1:] / 100.0).max() < 1e-12
     # specific force in sensor coordinates is constant: gravity plus Ω²r = 0.8 m/s² towards the
@@ -71,7 +67,7 @@ def test_steady_lever_arm_closed_form():
 
 
 def test_incline_motion_has_zero_mean_acceleration_and_the_stated_peak():
-    m = incline_oscillation(g=9.81).generate(10.0, 1000.0)
+    m = profile("incline").motion(g=9.81).generate(10.0, 1000.0)
     earth = Rotation.from_quat(m.quat, scalar_first=True).apply(m.acc) - [0, 0, 9.81]
     assert np.abs(earth.mean(axis=0)).max() < 1e-9
     assert np.linalg.norm(earth, axis=1).max() == pytest.approx(math.sqrt(2) * 9.81, rel=1e-4)
@@ -84,12 +80,11 @@ def test_closed_loop_diagram_equals_the_batch_pipeline(method):
     imu = ImuModel(delta_n=math.radians(0.1), gyr_offset=(0.01, 0.0, -0.01), acc_noise=0.01)
     fs = 100.0
     noise, resp = simulate_closed_loop(motion, imu, fs, duration=5.0, method=method, seed=3, gyro_offset=False)
-    state = motion.initial_state()
-    truth = np.empty((len(noise), 10))
-    _human_run(state, np.ascontiguousarray(noise[:, :6]), motion.coefficients(fs), truth)
-    gyr, acc = imu.measure(truth[:, 0:3], truth[:, 3:6], noise[:, 6:12], fs)
+    assert np.array_equal(noise, np.hstack([normals(3, MOTION, 500), normals(3, SENSOR, 500)]))
+    truth = motion.generate(5.0, fs, seed=3)  # the motion of the same noise
+    gyr, acc = imu.apply(truth, seed=3)
     est = estimate(gyr, acc, fs, method, initial_gravity=[0, 0, motion.g], gyro_offset=False)
-    up = Rotation.from_quat(truth[:, 6:10], scalar_first=True).inv().apply([0, 0, 1])
+    up = truth.up
     assert np.abs(resp.outputs[1:4].T - est.gravity).max() <= 1e-12
     assert np.abs(resp.outputs[4:8].T - est.quat).max() <= 1e-12
     assert np.abs(resp.outputs[0] - inclination_error(est.gravity, up)).max() <= 1e-12
@@ -100,13 +95,15 @@ def test_closed_loop_diagram_equals_the_batch_pipeline(method):
     ({"delta_n": math.radians(0.3), "rest_time": 1.0, "tau_heading": 2.0}, 0.015,
      {"mag_noise": 0.5, "mag_offset": (8.0, -3.0, 12.0)}),
 ])
-def test_closed_loop_diagram_with_offset_and_heading_blocks_equals_the_batch_kernels(params, latency, mag_errors):
+def test_closed_loop_diagram_with_offset_and_heading_blocks_equals_the_stages_run_one_by_one(params, latency,
+                                                                                              mag_errors):
     """motion → sensor → gyro-offset estimator → wiener → heading stage (fed by the
-    magnetometer block, ideal or with noise and hard iron) → latency stage as
-    python-control blocks: the same numbers as the batch path's kernels run over the
-    sensor's samples (the offset estimator's low-passes at rest on g·ẑ, as the diagram
-    starts it), with the defaults and with parameters of every stage; with a latency, the
-    sensor's delay line (at rest, level before the start) as well."""
+    magnetometer block, ideal or with noise and hard iron) → latency stage, interconnected
+    python-control blocks: the same numbers as each stage run alone in turn over the
+    sensor's samples (the offset estimator's block, its low-passes at rest on g·ẑ as the
+    diagram starts it; the batch path; with_magnetometer; carry_forward_rows), with the
+    defaults and with parameters of every stage; with a latency, the sensor's delay line (at
+    rest, level before the start) as well."""
     motion = HumanMotion()
     imu = ImuModel(delta_n=math.radians(0.1), gyr_offset=(0.01, 0.0, -0.01), acc_noise=0.01, latency=latency,
                    **mag_errors)
@@ -116,17 +113,16 @@ def test_closed_loop_diagram_with_offset_and_heading_blocks_equals_the_batch_ker
     noise_density = {k: v for k, v in params.items() if k == "delta_n"}  # the filter's and the offset estimator's
     offset_params = {**noise_density, **{k: v for k, v in params.items() if k == "rest_time"}}
     heading_params = {k: v for k, v in params.items() if k == "tau_heading"}
-    state = motion.initial_state()
-    truth = np.empty((len(noise), 10))
-    _human_run(state, np.ascontiguousarray(noise[:, :6]), motion.coefficients(fs), truth)
-    signals = imu.delayed(truth[:, 0:3], truth[:, 3:6], fs, before=[0.0, 0.0, 0.0, 0.0, 0.0, motion.g])
+    truth = motion.generate(5.0, fs, seed=3)  # the motion of the same noise
+    signals = imu.delayed(truth.gyr, truth.acc, fs, before=[0.0, 0.0, 0.0, 0.0, 0.0, motion.g])
     gyr, acc = imu.measure(*signals, noise[:, 6:12], fs)
-    coef = gyro_offset.coefficients(gyro_offset.resolve(offset_params), 1.0 / fs)
-    offset, variance = np.empty_like(gyr), np.empty_like(gyr)
-    gyro_offset.run(gyro_offset.initial_state(coef, np.zeros(3), np.array([0.0, 0.0, motion.g])), coef,
-                    gyr, np.ascontiguousarray(acc), offset, variance)
+    dt, t = 1.0 / fs, np.arange(len(gyr)) / fs  # the offset estimator alone, started as the diagram starts it
+    x0 = gyro_offset.initial_state(gyro_offset.coefficients(gyro_offset.resolve(offset_params), dt), np.zeros(3),
+                                   [0.0, 0.0, motion.g])
+    offset = control.input_output_response(gyro_offset.offset_system(dt, offset_params), t, np.hstack([gyr, acc]).T,
+                                           X0=x0).outputs[3:6].T
     est = estimate(gyr - offset, acc, fs, params=noise_density, initial_gravity=[0, 0, motion.g], gyro_offset=False)
-    mag = imu.measure_mag(Rotation.from_quat(truth[:, 6:10], scalar_first=True).inv().apply(EARTH_FIELD_UT),
+    mag = imu.measure_mag(Rotation.from_quat(truth.quat, scalar_first=True).inv().apply(EARTH_FIELD_UT),
                           noise[:, 12:15], fs)
     quat, _, mag_offset, _ = with_magnetometer(est.quat, mag, fs, heading_params)
     out = dict(zip(resp.output_labels, resp.outputs))

@@ -1,15 +1,11 @@
 """The native co-simulation chain: MotionProfile.fmu and ImuSensor.fmu in C against the batch
-motion and sensor (and their pythonfmu twins), the FMI 3.0 estimator against the FMI 2.0 one,
+motion and sensor (and the pythonfmu FMUs of the same interfaces), the FMI 3.0 estimator against the FMI 2.0 one,
 the native chain against the pythonfmu chain with the same seeds, the SSPs `attitude ssp`
 writes under libcosim and fmpy's SSP reader, and the master's C stepping loop against its
 Python one."""
 import json
 import math
-import os
 import shutil
-import tempfile
-import zipfile
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -21,46 +17,20 @@ from fmpy.ssp.ssd import read_ssd
 from fmpy.validation import validate_fmu
 
 from attitude_fmu.blocks.methods.registry import METHODS
-from attitude_fmu.systems.fmi import native, stepping
+from attitude_fmu.systems.fmi import stepping
 from attitude_fmu.systems.fmi import verify as verify_module
-from attitude_fmu.systems.fmi.build import FMU_NAMES, build_fmus
 from attitude_fmu.systems.fmi.cosim import FmuRunner, cosimulate, cosimulate_libcosim, load_slave
 from attitude_fmu.systems.fmi.ssp import write_ssp
 from attitude_fmu.systems.simulation.motion import PROFILES, HumanMotion
 from attitude_fmu.systems.simulation.sensor_model import ImuModel
-from tests.native import SANITIZE, SANITIZERS, sanitized_pytest
 
 FS = 100.0
-SANITIZED = bool(os.environ.get(SANITIZE))  # this is the sanitized run: the native FMUs only
 NATIVE_FMUS = ("native/AttitudeEstimator", "native/ImuSensor", "native/MotionProfile", "native/fmi3/AttitudeEstimator")
 TRUTH = [f"{s}_{a}" for s in ("omega", "f", "m") for a in "xyz"] + [f"qt_{c}" for c in "wxyz"]
 SENSOR_IN = [f"{s}_{a}" for s in ("omega", "f", "m") for a in "xyz"]
 SENSOR_OUT = [f"{s}_{a}" for s in ("gyr", "acc", "mag") for a in "xyz"]
 ESTIMATOR_OUT = ["q_w", "q_x", "q_y", "q_z", "g_x", "g_y", "g_z", "roll", "pitch", "yaw", "gyr_offset_x",
                  "gyr_offset_y", "gyr_offset_z", "mag_offset_x", "mag_offset_y", "mag_offset_z", "mag_delay_used"]
-
-
-@pytest.fixture(scope="module")
-def fmu_dir(tmp_path_factory):
-    """Every FMU; in the sanitized run (sanitized_pytest) the native ones alone, their binaries
-    compiled again from their sources/ with the address and undefined-behaviour sanitizers."""
-    out = tmp_path_factory.mktemp("fmus")
-    build_fmus(out, () if SANITIZED else FMU_NAMES)
-    for name in NATIVE_FMUS if SANITIZED else ():
-        _sanitize(out / f"{name}.fmu")
-    return out
-
-
-def _sanitize(fmu: Path) -> None:
-    with tempfile.TemporaryDirectory() as tmp:
-        with zipfile.ZipFile(fmu) as zf:
-            zf.extractall(tmp)
-            names = zf.namelist()
-        binary = next(n for n in names if n.startswith("binaries/"))
-        native.compile_binary(Path(tmp) / "sources", Path(tmp) / binary, ("-Werror", *SANITIZERS))
-        with zipfile.ZipFile(fmu, "w") as zf:
-            for name in names:
-                zf.write(Path(tmp) / name, name)
 
 
 def test_every_native_fmu_validates_and_fmi3_has_the_fmi2_variables(fmu_dir):
@@ -95,7 +65,7 @@ def test_the_motion_fmus_equal_the_batch_motion(fmu_dir, name):
     motion = prof.motion(changed, g=9.79).generate(8.0, FS, seed=5)
     expected = np.hstack([motion.gyr, motion.acc, motion.mag, motion.quat])
     parameters = {"profile": name, "seed": 5, "g": 9.79, **{f"{name}_{k}": v for k, v in changed.items()}}
-    for fmu in ("native/MotionProfile", *(() if SANITIZED else ("MotionProfile",))):
+    for fmu in ("native/MotionProfile", "MotionProfile"):
         got = _run(fmu_dir / f"{fmu}.fmu", parameters, np.empty((len(expected), 0)), [], TRUTH)
         for columns in (slice(0, 3), slice(3, 6), slice(6, 9), slice(9, 13)):
             scale = max(1.0, np.abs(expected[:, columns]).max())
@@ -117,7 +87,7 @@ def test_the_sensor_fmus_equal_imu_model_apply(fmu_dir, latency):
                   "seed": 9, **{f"{v}_{c}": x for v in ("gyr_offset", "acc_offset", "mag_offset")
                                 for c, x in zip("xyz", getattr(imu, v))},
                   **{f"gyr_scale_{r}_{c}": scale[i][j] for i, r in enumerate("xyz") for j, c in enumerate("xyz")}}
-    for fmu in ("native/ImuSensor", *(() if SANITIZED else ("ImuSensor",))):
+    for fmu in ("native/ImuSensor", "ImuSensor"):
         got = _run(fmu_dir / f"{fmu}.fmu", parameters, np.hstack([motion.gyr, motion.acc, motion.mag]), SENSOR_IN,
                    SENSOR_OUT)
         assert np.abs(got - expected).max() < 1e-12 * np.abs(expected).max(), fmu
@@ -155,6 +125,15 @@ def _refusal(fmu, parameters) -> str:
 ])
 def test_the_native_fmus_refuse_what_the_pythonfmu_ones_refuse_in_their_words(fmu_dir, fmu, parameters):
     assert _refusal(fmu_dir / "native" / f"{fmu}.fmu", parameters) == _refusal(fmu_dir / f"{fmu}.fmu", parameters)
+
+
+def test_the_native_sensor_refuses_a_latency_longer_than_its_delay_line_at_the_first_step(fmu_dir, capsys):
+    runner = FmuRunner(fmu_dir / "native" / "ImuSensor.fmu", {"latency": 11.0}, [f"f_{c}" for c in "xyz"], ["acc_z"])
+    with pytest.raises(FMICallException) as info:
+        runner.step([0.0, 0.0, 9.81], 0.01)
+    assert info.value.status == 3
+    runner.fmu.freeInstance()
+    assert "latency 11.0 s at 100.0 Hz is longer than the delay line's 1021 samples" in capsys.readouterr().out
 
 
 def _fmi3_run(fmu, parameters, inputs, h):
@@ -232,26 +211,6 @@ def test_the_c_stepping_loop_equals_the_python_one(fmu_dir, tmp_path, monkeypatc
     assert all(np.array_equal(fast[k], slow[k]) and fast[k].dtype == slow[k].dtype for k in fast)
 
 
-def test_the_c_stepping_loop_is_compiled_once_per_user_and_source(tmp_path, monkeypatch):
-    """Each process (a Dask worker, a second verify) loads the loop another compiled, from
-    the per-user cache, and leaves no folder behind; without a per-user cache (no home
-    folder) it gets a folder of its own, removed at exit."""
-    monkeypatch.setenv("ATTITUDE_FMU_CACHE", str(tmp_path / "cache"))
-    path = stepping.library_path()
-    assert path.parent == tmp_path / "cache" / "c" and not path.exists()
-    stepping.library.cache_clear()
-    assert stepping.library() is not None and path.exists()
-    built = path.stat().st_mtime_ns
-    stepping.library.cache_clear()
-    assert stepping.library() is not None and path.stat().st_mtime_ns == built  # loaded, not compiled again
-    assert sorted(p.name for p in path.parent.iterdir()) == [path.name]  # no staged file left
-    monkeypatch.setattr(stepping, "user_cache", lambda: (_ for _ in ()).throw(RuntimeError("no home folder")))
-    own = stepping.library_path().parent
-    assert own.name.startswith("attitude_stepping_")
-    shutil.rmtree(own)  # (this process ends in os._exit: tests/conftest.py)
-    stepping.library.cache_clear()
-
-
 def test_attitude_ssp_files_run_in_libcosim_and_give_the_verify_figures(fmu_dir, tmp_path, monkeypatch, capsys):
     """`attitude ssp --out DIR` writes one self-contained SSP per profile × method; libcosim
     (CosimExecution.from_ssp_file) runs it unchanged, and its figures, with its estimate two
@@ -310,16 +269,3 @@ def test_the_c_stepping_loop_reports_the_component_that_failed(fmu_dir, tmp_path
     bad = write_ssp(tmp_path / "late.ssp", fmu_dir, {"imu": {"latency": 30.0}}, 1.0, 0.01, chain="native")
     with pytest.raises(RuntimeError, match="component imu failed at t = 0 s"):
         cosimulate(bad, 1.0, 0.01)
-
-
-@pytest.mark.skipif(SANITIZED, reason="this is the sanitized run")
-def test_the_native_fmus_run_clean_under_the_sanitizers():
-    """The native MotionProfile, ImuSensor and the FMI 3.0 estimator's tests again, their binaries
-    built with -fsanitize=address,undefined: any out-of-bounds access or undefined behaviour
-    fails them."""
-    run = sanitized_pytest(__file__, "-x", "-k", "motion_fmus and (human or step_rotation) or sensor_fmus "
-                           "or fmi3_estimator and wiener or reports")
-    if run is None:
-        pytest.skip("the C compiler names no address-sanitizer runtime")
-    assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
-    assert "runtime error" not in run.stderr and "Sanitizer" not in run.stderr, run.stderr[-3000:]

@@ -1,7 +1,8 @@
-"""The native AttitudeEstimator.fmu (in C, no Python): equal to blocks.pipeline.online's step on
-every configuration, in a C host (plain and built with sanitizers), under fmpy and libcosim; the
-FMI state machine, FMU states, logging; what its binary links and what its zip holds; its
-source FMU compiled by fmpy; its build without a compiler."""
+"""The native AttitudeEstimator.fmu (in C, no Python: its own configuration, design and
+discretisation on the C core): the outputs of blocks.pipeline.online's step (the same core
+behind Python's c2d) on every configuration, in a C host (plain and built with sanitizers),
+under fmpy and libcosim; the FMI state machine, FMU states, logging; what its binary links and
+what its zip holds; its source FMU compiled by fmpy; the package without its native FMUs."""
 import itertools
 import math
 import os
@@ -30,6 +31,7 @@ from attitude_fmu.systems.fmi import native
 from attitude_fmu.systems.fmi.build import build_fmus
 from attitude_fmu.systems.fmi.cosim import cosimulate_libcosim
 from attitude_fmu.systems.fmi.ssp import write_ssp
+from tests import native as c_build
 from tests.test_real_data import _turns_with_field
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -44,7 +46,6 @@ CONFIGS = [dict(zip(("method", "heading", "gyro_offset", "gyr_samples", "acc_sam
                                       ("point", "mean"), (0.0, 0.004))]
 BAD_ROWS = {300: ("gyr_x", math.nan), 450: ("acc_z", math.inf), 600: ("gyr_y", 1.01 * MAX_GYR_RAD_S),
             750: ("acc_x", -1.01 * MAX_ACC_M_S2), 1050: ("gyr_z", -math.inf)}
-SANITIZERS = ("-fsanitize=address,undefined", "-fno-sanitize-recover=all", "-fno-omit-frame-pointer", "-g")
 SANITIZER_REPORTS = ("AddressSanitizer", "LeakSanitizer", "runtime error", "UndefinedBehaviorSanitizer")
 
 
@@ -101,9 +102,10 @@ def assert_equal(result, expected, label=""):
 
 
 @pytest.fixture(scope="module")
-def fmus(tmp_path_factory):
-    out = tmp_path_factory.mktemp("native")
-    return {name: native.build_native_fmu(name, out) for name in ("AttitudeEstimator", "NoOpEstimator")}
+def fmus(fmu_dir):
+    """The native estimator as build_fmus copies it, and the no-op FMU of the same interface (built/)."""
+    return {"AttitudeEstimator": fmu_dir / "native" / "AttitudeEstimator.fmu",
+            "NoOpEstimator": native.built("native/NoOpEstimator.fmu")}
 
 
 @pytest.fixture(scope="module")
@@ -132,25 +134,19 @@ def references(rows):
 
 
 @pytest.fixture(scope="module")
-def runner(tmp_path_factory):
-    """tests/fmi_runner.c compiled, plain and with sanitizers."""
-    folder = tmp_path_factory.mktemp("runner")
-    built = {}
-    for kind, flags in (("plain", ("-O1",)), ("sanitized", SANITIZERS)):
-        built[kind] = folder / f"fmi_runner_{kind}"
-        subprocess.run([*native.compiler(), "-std=c99", "-Wall", "-Wextra", "-Werror", *flags,
-                        f"-I{native.FMI_HEADERS}", "-o", str(built[kind]), str(ROOT / "tests" / "fmi_runner.c"), "-ldl"],
-                       check=True, capture_output=True, text=True)
-    return built
+def runner():
+    """tests/fmi_runner.c, a CMake target (tests/native.py)."""
+    return {"plain": c_build.build(["fmi_runner"]) / "tests" / "fmi_runner"}
 
 
 @pytest.fixture(scope="module")
-def sanitized_binary(tmp_path_factory):
-    """The native estimator's binary built from its sources with address and undefined-behaviour
-    sanitizers (and -Werror: the sources are -Wall -Wextra clean)."""
-    folder = tmp_path_factory.mktemp("sanitized")
-    sources = native.write_sources("AttitudeEstimator", folder / "sources")
-    return native.compile_binary(sources, folder / "AttitudeEstimator.so", (*SANITIZERS, "-Werror"))
+def sanitized(tmp_path_factory):
+    """tests/fmi_runner.c and the native estimator built with the address and undefined-behaviour
+    sanitizers (and -Werror: the sources are -Wall -Wextra clean): (the runner, the FMU's binary)."""
+    folder = c_build.build(["fmi_runner", "fmus"], sanitize=True)
+    unzipped = Path(extract(str(folder / "built" / "native" / "AttitudeEstimator.fmu"),
+                            str(tmp_path_factory.mktemp("sanitized"))))
+    return folder / "tests" / "fmi_runner", unzipped / native.binary_path("AttitudeEstimator")
 
 
 def run_script(runner, lines, folder, sanitized=False):
@@ -237,17 +233,19 @@ def test_every_configuration_in_a_c_host_equals_the_python_step(runner, unzipped
     assert np.abs(out[-1, 10:13]).max() > 0  # the gyro offset estimated
 
 
-def test_the_binary_built_with_sanitizers_runs_every_configuration_without_a_report(
-        runner, sanitized_binary, md, vr, rows, references, tmp_path):
+@pytest.mark.slow
+def test_the_binary_built_with_sanitizers_runs_every_configuration_without_a_report(sanitized, md, vr, rows, references,
+                                                                                    tmp_path):
     """The same replay, the FMI robustness script and 1000 instance cycles with the estimator's
     sources built with -fsanitize=address,undefined in a C host built alike (no LD_PRELOAD):
     no sanitizer report, no leak, and the same results."""
+    sanitized_runner, sanitized_binary = sanitized
     configs = CONFIGS[::4]  # every method with each option at both values; sanitizers are slow
-    results = replay_configs(runner["sanitized"], sanitized_binary, md, vr, configs, rows, tmp_path, sanitized=True)
+    results = replay_configs(sanitized_runner, sanitized_binary, md, vr, configs, rows, tmp_path, sanitized=True)
     for config, result, expected in zip(configs, results, references[::4]):
         assert_equal(result, expected, config)
     script, expected_statuses = robustness_script(md, vr, sanitized_binary)
-    statuses, _, _ = run_script(runner["sanitized"], script, tmp_path, sanitized=True)
+    statuses, _, _ = run_script(sanitized_runner, script, tmp_path, sanitized=True)
     assert [line for line in statuses if line and not line.startswith("get_real")] == expected_statuses
 
 
@@ -352,14 +350,13 @@ def test_fmpy_with_one_instance_reset_between_configurations_equals_the_python_s
     fmu.freeInstance()
 
 
-def test_the_model_description_validates_and_matches_the_pythonfmu_fmu(fmus, md, tmp_path):
+def test_the_model_description_validates_and_matches_the_pythonfmu_fmu(fmus, md, fmu_dir):
     """fmpy.validate_fmu finds no problem in either native FMU; the native estimator's
     variables are the pythonfmu FMU's: names, value references, types, causalities,
     variabilities, initial, units, start values, descriptions (so an SSP may take either)."""
     for path in fmus.values():
         assert validate_fmu(str(path)) == [], path
-    build_fmus(tmp_path, ("AttitudeEstimator",), native=())
-    theirs = read_model_description(str(tmp_path / "AttitudeEstimator.fmu"))
+    theirs = read_model_description(str(fmu_dir / "AttitudeEstimator.fmu"))
 
     def table(description):
         return [(v.name, v.valueReference, v.type, v.causality, v.variability, v.initial, v.unit, str(v.start),
@@ -484,6 +481,7 @@ def test_debug_logging_by_category_and_warnings_always(md, vr, unzipped):
     fmu.freeInstance()
 
 
+@pytest.mark.slow
 def test_fmpy_compiles_the_source_fmu_into_a_working_binary(fmus, md, vr, rows, references, tmp_path):
     """The FMU's sources/ and buildDescription.xml are all an importer on another platform needs:
     fmpy's compile step (CMake) builds a binary from them alone that gives the Python step."""
@@ -507,13 +505,11 @@ def test_fmpy_compiles_the_source_fmu_into_a_working_binary(fmus, md, vr, rows, 
     assert np.abs(out - references[0][0][:500]).max() < 1e-9
 
 
-def test_libcosim_runs_an_ssp_with_the_native_estimator_and_it_computes_the_python_step(tmp_path):
+def test_libcosim_runs_an_ssp_with_the_native_estimator_and_it_computes_the_python_step(fmu_dir, tmp_path):
     """libcosim (its own SSP reader, FMI Library, master) runs the diagram with the native
     estimator beside the pythonfmu one: its outputs, on the inputs libcosim handed it, are
     blocks.pipeline.online's within 1e-9, and equal the pythonfmu estimator's."""
     pytest.importorskip("libcosimpy")
-    fmu_dir = tmp_path / "fmus"
-    build_fmus(fmu_dir)
     ssp = write_ssp(tmp_path / "human.ssp", fmu_dir, {
         "motion": {"profile": "human", "seed": 3},
         "imu": {"delta_n": math.radians(0.1), "seed": 4, "gyr_offset_z": 0.01, "mag_noise": 0.2, "mag_offset_x": 9.0},
@@ -563,27 +559,29 @@ def test_a_broad_recording_and_a_long_stream_give_the_python_step(runner, unzipp
         TS = saved
 
 
-def test_without_a_c_compiler_the_pythonfmu_fmus_still_build_and_a_warning_says_why(tmp_path, monkeypatch):
-    monkeypatch.setenv("CC", str(tmp_path / "no-such-cc"))
+def test_where_the_build_made_no_native_fmus_the_pythonfmu_ones_still_build_and_a_warning_says_why(tmp_path,
+                                                                                                     monkeypatch):
+    monkeypatch.setattr(native, "BUILT", tmp_path / "nothing built")
     said = []
-    assert native.build_native_fmus(tmp_path / "native", log=said.append) == []
+    assert native.copy_fmus(tmp_path / "native", native.NATIVE_NAMES, log=said.append) == []
     assert ("the native FMUs (AttitudeEstimator.fmu, ImuSensor.fmu, MotionProfile.fmu: in C, no Python) are not "
-            "built") in said[0]
-    assert "no C compiler" in said[0] and "set CC" in said[0]
+            "copied") in said[0]
+    assert "pip install ." in said[0] and "python build_fmu.py" in said[0]
     assert [p.name for p in build_fmus(tmp_path, ("MotionProfile",))] == ["MotionProfile.fmu"]
     assert not (tmp_path / "native" / "AttitudeEstimator.fmu").exists()
 
 
-def test_a_native_fmu_built_from_other_sources_is_not_current(tmp_path):
-    """Its guid is a digest of its sources: one of another build is not current (ensure_built
-    rebuilds it)."""
-    fresh = native.build_native_fmu("NoOpEstimator", tmp_path / "fresh")
+def test_a_native_fmu_of_another_build_is_not_current(fmus, tmp_path):
+    """Its guid is a digest of what it is built from: one of another build is not current
+    (ensure_built replaces it)."""
+    fresh = fmus["NoOpEstimator"]
     assert native.is_current(fresh)
     stale = tmp_path / "NoOpEstimator.fmu"
+    guid = read_model_description(str(fresh)).guid
     with zipfile.ZipFile(fresh) as src, zipfile.ZipFile(stale, "w") as dst:
         for item in src.infolist():
             data = src.read(item)
             if item.filename == "modelDescription.xml":
-                data = data.replace(native.guid("NoOpEstimator").encode(), b"{00000000-0000-0000-0000-000000000000}")
+                data = data.replace(guid.encode(), b"{00000000-0000-0000-0000-000000000000}")
             dst.writestr(item, data)
     assert not native.is_current(stale) and not native.is_current(tmp_path / "missing.fmu")

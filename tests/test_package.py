@@ -23,14 +23,16 @@ def _module(path: Path) -> str:
     return ".".join(("attitude_fmu", *(parts[:-1] if parts[-1] == "__init__" else parts)))
 
 
+@pytest.mark.slow
 def test_one_import_package_installs_beside_the_pypi_package_systems(tmp_path):
-    """pip install . puts attitude_fmu, and nothing else, at the top of site-packages: the
-    PyPI package `systems` ("Describe and run systems diagrams") installs beside it and
-    both import. Built from a copy of the sources, without dependencies (what is checked
-    is where the files land)."""
+    """pip install . (scikit-build-core driving CMake) puts attitude_fmu, and nothing else, at
+    the top of site-packages, with the compiled extension attitude_fmu._core and the native
+    FMUs the build made: the PyPI package `systems` ("Describe and run systems diagrams")
+    installs beside it and both import. Built from a copy of the sources, without
+    dependencies (what is checked is what is built and where the files land)."""
     source = tmp_path / "source"
-    shutil.copytree(ROOT, source, ignore=shutil.ignore_patterns(".git", "build", "dist", "*.egg-info", ".venv*",
-                                                                "__pycache__", "*.nbi", "*.nbc"))
+    shutil.copytree(ROOT, source, ignore=shutil.ignore_patterns(".git", "build", "built", "dist", "*.egg-info", ".venv*",
+                                                                "__pycache__", "_core.*", ".*.tmp", ".ruff_cache"))
     env_dir = tmp_path / "env"
     venv.create(env_dir, with_pip=True)
     python = env_dir / "bin" / "python"
@@ -50,16 +52,19 @@ def test_one_import_package_installs_beside_the_pypi_package_systems(tmp_path):
                 missing.append(name)
         dist = importlib.metadata.distribution("attitude-fmu")
         print(json.dumps({"missing": missing, "systems": systems.__file__, "ours": attitude_fmu.systems.__file__,
-                          "top_level": dist.read_text("top_level.txt").split(),
-                          "files": sorted({f.parts[0] for f in dist.files})}))
+                          "top": sorted({f.parts[0] for f in dist.files}),
+                          "files": sorted("/".join(f.parts[1:]) for f in dist.files if f.parts[0] == "attitude_fmu")}))
     """)
     out = subprocess.run([str(python), "-c", script], capture_output=True, text=True, cwd=tmp_path)
     assert out.returncode == 0, out.stderr[-3000:]
     found = __import__("json").loads(out.stdout)
     assert found["missing"] == ["blocks", "fmu_src"]
     assert "attitude_fmu" not in found["systems"] and "attitude_fmu" in found["ours"]
-    assert found["top_level"] == ["attitude_fmu"]
-    assert set(found["files"]) <= {"attitude_fmu", "attitude_fmu-0.1.0.dist-info", ".."}, found["files"]  # ..: bin/
+    assert set(found["top"]) <= {"attitude_fmu", "attitude_fmu-0.1.0.dist-info", ".."}, found["top"]  # ..: bin/
+    files = found["files"]
+    assert [f for f in files if f.startswith("_core.") and f.endswith((".so", ".pyd"))], files
+    assert {f"built/native/{n}.fmu" for n in ("AttitudeEstimator", "ImuSensor", "MotionProfile")} <= set(files)
+    assert "built/native/fmi3/AttitudeEstimator.fmu" in files and "blocks/pipeline/online.py" in files
 
 
 def test_the_public_api_gives_every_name_it_lists_with_a_docstring():
@@ -129,7 +134,7 @@ def test_no_import_cycle_between_subpackages():
 
 
 DOTTED = re.compile(r"(?<![\w.])((?:blocks|systems|fmu_src)(?:\.\w+)+)")
-FILE_REFERENCE = re.compile(r"(?<![\w./])((?:docs|tests|fmu_src|blocks|systems)/[\w./-]+\.(?:md|py|c))")
+FILE_REFERENCE = re.compile(r"(?<![\w./])((?:docs|tests|fmu_src|blocks|systems)/[\w./-]+\.(?:md|py|cpp|c|h))(?!\w)")
 
 
 def _resolves(dotted: str) -> bool:
@@ -161,3 +166,40 @@ def test_every_cross_reference_in_a_docstring_resolves_inside_the_repository():
             unresolved += [f"{path.name}: {ref}" for ref in FILE_REFERENCE.findall(doc)
                            if not (ROOT / ref.rstrip(".")).exists()]
     assert unresolved == []
+
+
+PYTHON_FILES = sorted(p for p in ROOT.rglob("*.py") if not ({".git", "build", "built", "docs"} & set(p.relative_to(ROOT).parts))
+                      and not p.relative_to(ROOT).parts[0].startswith(".venv"))
+
+
+def test_no_module_imports_numba():
+    """The C core is the one implementation: no module (of the package, its build or its tests)
+    imports numba, and the dependencies do not name it."""
+    importing = [str(p.relative_to(ROOT)) for p in PYTHON_FILES
+                 if {"numba", "llvmlite"} & {name.split(".")[0] for name in _imports_of(p)}]
+    assert importing == []
+    assert "numba" not in (ROOT / "pyproject.toml").read_text(encoding="utf-8")
+
+
+def _imports_of(path: Path) -> set[str]:
+    names = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            names.update(a.name for a in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+            names.add(node.module)
+    return names
+
+
+# a C compiler named as a program, its flags for a shared library, or the compiler Python was built with
+COMPILER_CALL = re.compile(r"""["'](?:gcc|clang|cc|g\+\+|clang\+\+|-shared|-fPIC)["']|get_config_var\(\s*["']CC["']"""
+                           r"""|environ(?:\.get\(|\[)\s*["']CC["']""")
+
+
+def test_no_python_module_calls_a_c_compiler():
+    """Every C artefact is a CMake target (CMakeLists.txt); Python drives CMake, never a
+    compiler: no Python file names one, its shared-library flags or $CC."""
+    calling = {str(p.relative_to(ROOT)): COMPILER_CALL.findall(p.read_text(encoding="utf-8")) for p in PYTHON_FILES
+               if p != Path(__file__).resolve()}
+    assert {path: found for path, found in calling.items() if found} == {}
+    assert COMPILER_CALL.search('subprocess.run(["gcc", "-shared"])') and COMPILER_CALL.search('os.environ.get("CC")')

@@ -4,6 +4,7 @@ results are those of the files docs/figures.py writes."""
 import json
 import re
 import shlex
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -12,7 +13,6 @@ import numpy as np
 import pytest
 
 from attitude_fmu.systems.cli.commands import build_parser
-from attitude_fmu.systems.fmi.build import build_fmus
 
 ROOT = Path(__file__).resolve().parent.parent
 README = (ROOT / "README.md").read_text(encoding="utf-8")
@@ -20,12 +20,12 @@ GENERATED = ROOT / "docs" / "generated"
 
 
 @pytest.fixture(scope="module")
-def fmu_folder(tmp_path_factory):
-    """A folder whose dist/ holds the FMUs, where the examples run (each in a process of its
-    own: an FMU loaded in the test process would tie its exit to pythonfmu's,
-    systems.fmi.cosim.fmus_loaded)."""
+def fmu_folder(fmu_dir, tmp_path_factory):
+    """A folder whose dist/ holds the FMUs (the session's, attitude_fmu.build_fmus), where the
+    examples run (each in a process of its own: an FMU loaded in the test process would tie
+    its exit to pythonfmu's, systems.fmi.cosim.fmus_loaded)."""
     folder = tmp_path_factory.mktemp("examples")
-    build_fmus(folder / "dist")
+    shutil.copytree(fmu_dir, folder / "dist")
     for args in _readme_commands():
         if args[0] == "ssp":  # as written, where the README's examples run
             run = subprocess.run([sys.executable, "-m", "attitude_fmu.systems.cli.commands", *args], cwd=folder,

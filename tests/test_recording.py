@@ -15,8 +15,10 @@ from attitude_fmu.blocks.pipeline.batch import estimate
 from attitude_fmu.systems.cli.commands import main
 from attitude_fmu.systems.recordings.reading import read_recording
 from attitude_fmu.systems.recordings.recording import IMU_COLUMNS, REF_COLUMNS, RecordingError
-from attitude_fmu.systems.simulation.motion import ClosedFormMotion, HumanMotion
+from attitude_fmu import profile
+from attitude_fmu.systems.simulation.motion import HumanMotion
 from attitude_fmu.systems.simulation.sensor_model import ImuModel
+from tests.motions import ClosedFormMotion
 
 FS = 100.0
 
@@ -191,27 +193,17 @@ def test_a_sensor_held_at_its_range_is_noted(tmp_path):
     are a 1 kHz recording of a ±90° swing at 1 Hz (a smooth peak of 565 °/s, where 16-bit
     samples of ±2000 °/s hold one value for a few ms) and a noise-free turntable at a
     steady 3 rad/s (16-bit samples, which hold it exactly), throughout or after 40 s at rest."""
-    from scipy.spatial.transform import Rotation
-
-    from attitude_fmu.systems.simulation.motion import (
-        ClosedFormMotion,
-        offset_rotation,
-        sine_rotation,
-        steady_lever_arm,
-    )
-
     lsb = math.radians(2000.0) / 32768
     quantized = lambda g, a: (np.round(g / lsb) * lsb, np.round(a / 1e-3) * 1e-3)
     sensor = ImuModel(delta_n=math.radians(0.05), acc_noise=0.002)
     human = quantized(*sensor.apply(HumanMotion(delta_v=0.2, omega_c=5.0).generate(60.0, FS, seed=8), seed=9))
-    arm = quantized(*sensor.apply(offset_rotation(frequency=0.5, amplitude_deg=90.0, radius=1.0).generate(60.0, FS),
-                                  seed=9))
-    gyr_limit = math.radians(125.0)
-    swing = sine_rotation(amplitude_deg=90.0, frequency=1.0).generate(30.0, 1000.0)
+    arm_motion = profile("offset_rotation").motion({"frequency": 0.5, "amplitude_deg": 90.0, "radius": 1.0})
+    arm = quantized(*sensor.apply(arm_motion.generate(60.0, FS), seed=9))
+    swing = profile("sine_rotation").motion({"amplitude_deg": 90.0, "frequency": 1.0}).generate(30.0, 1000.0)
     assert np.abs(swing.gyr).max() > math.radians(560.0)
-    turntable = steady_lever_arm(rate=3.0).generate(60.0, FS)
+    turntable = profile("lever_arm").motion({"rate": 3.0}).generate(60.0, FS)
     turned = lambda t: Rotation.from_rotvec(np.outer(3.0 * np.maximum(t - 40.0, 0.0), [0, 0, 1]))
-    started = ClosedFormMotion("started", turned, lambda t: np.zeros((len(t), 3))).generate(60.0, FS)
+    started = ClosedFormMotion(turned).generate(60.0, FS)
     gyr_limit = math.radians(125.0)
     cases = [  # (name, (gyr, acc), the note, rate)
         ("gyro", (np.clip(human[0], -gyr_limit, gyr_limit), human[1]),
@@ -394,8 +386,8 @@ def test_time_stamps_that_cannot_be_read_as_one_rate_are_refused(tmp_path, recor
 
 
 def _turns():
-    return ClosedFormMotion("turns", lambda t: Rotation.from_euler("ZY", np.column_stack([
-        0.8 * np.sin(0.5 * t), 0.5 * np.sin(0.3 * t)])), lambda t: np.zeros((len(t), 3))).generate(60.0, FS)
+    return ClosedFormMotion(lambda t: Rotation.from_euler("ZY", np.column_stack([
+        0.8 * np.sin(0.5 * t), 0.5 * np.sin(0.3 * t)]))).generate(60.0, FS)
 
 
 def test_a_csv_with_a_reference_is_evaluated_as_the_same_mat(tmp_path, capsys):

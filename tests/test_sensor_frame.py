@@ -1,5 +1,5 @@
 """The sensor-frame estimator blocks: linearisation, exactness, and one step behind
-the continuous block, the discrete block, the batch path and the plain-Python source."""
+the continuous block, the discrete block and the batch path."""
 import math
 
 import control
@@ -13,7 +13,6 @@ from attitude_fmu.blocks.filters.sensor_frame import initial_state, sensor_frame
 from attitude_fmu.blocks.methods.registry import method
 from attitude_fmu.blocks.pipeline.batch import estimate
 from attitude_fmu.systems.simulation.motion import HumanMotion
-from tests.interpreted import interpreted_json
 
 FILTERS = {
     "eq34": ef.butterworth(0.13),
@@ -56,20 +55,6 @@ def test_discrete_block_and_batch_path_are_equal(name):
     batch = estimate(gyr, acc, fs, name, {"stationary": 1} if name == "wiener" else None, gyro_offset=False)  # the LTI filter
     assert np.abs(resp.outputs[:3].T - batch.gravity).max() <= 1e-12
     assert np.abs(resp.outputs[3:].T - batch.quat).max() <= 1e-12
-
-
-def test_compiled_kernel_equals_its_plain_python_source():
-    """The batch path run with numba's JIT disabled (the readable reference) gives the same numbers."""
-    code = (
-        "import json, numpy as np; from attitude_fmu.blocks.pipeline.batch import estimate;"
-        "from tests.test_sensor_frame import _random_imu;"
-        "g, a = _random_imu(); e = estimate(g, a, 100.0, gyro_offset=False);"
-        "print(json.dumps([e.gravity.tolist(), e.quat.tolist()]))"
-    )
-    gravity, quat = (np.array(x) for x in interpreted_json(code))
-    compiled = estimate(*_random_imu(), 100.0, gyro_offset=False)
-    assert np.abs(gravity - compiled.gravity).max() <= 1e-12
-    assert np.abs(quat - compiled.quat).max() <= 1e-12
 
 
 def test_pure_rotation_without_acceleration_is_tracked_exactly():

@@ -1,4 +1,4 @@
-/* messages.c: Python twin: Python's repr of floats and strings (see messages.h). */
+/* messages.c: Python's repr of floats and strings, and refusals (see messages.h). */
 #include "messages.h"
 
 #include <math.h>

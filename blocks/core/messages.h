@@ -1,6 +1,5 @@
-/* messages.h: the refusals of the C core worded as their Python twins word them.
- * Python twin: the formatting of Python's own messages (repr of a float or a string, f"{x:g}"),
- * as blocks/params.py, blocks/stages/timing.py and blocks/methods/registry.py use it. */
+/* messages.h: the wording of the C core's refusals, which the Python package raises as they are:
+ * values shown as Python shows them (repr of a float or a string; f"{x:g}" is printf's %g). */
 #ifndef AF_MESSAGES_H
 #define AF_MESSAGES_H
 

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 
-STANDARD_GRAVITY = 9.81  # m/s², the value the project uses for |g|
+from attitude_fmu.blocks.tuning import STANDARD_GRAVITY  # m/s², the value the project uses for |g|
 
 
 def omega_g(delta_n: float, delta_v: float, g: float = STANDARD_GRAVITY) -> float:

@@ -17,6 +17,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from attitude_fmu import _core
+
 FAR_POLE = 1000.0  # rad/s: poles that make G_A proper for simulation, far above its zeros (10, 20 rad/s)
 
 
@@ -128,12 +130,7 @@ def euler_complementary(gyr, acc, fs: float):
     gyr, acc = np.asarray(gyr, dtype=float), np.asarray(acc, dtype=float)
     roll_acc, pitch_acc, _ = euler_from_gravity_mag(acc)
     Ts = 1.0 / fs
-    roll_gyr, pitch_gyr = np.empty(len(gyr)), np.empty(len(gyr))
-    phi, theta = roll_acc[0], pitch_acc[0]
-    for k, (p, q, r) in enumerate(gyr):
-        phi, theta = (phi + Ts * (p + np.tan(theta) * (q * np.sin(phi) + r * np.cos(phi))),
-                      theta + Ts * (q * np.cos(phi) - r * np.sin(phi)))
-        roll_gyr[k], pitch_gyr[k] = phi, theta
+    roll_gyr, pitch_gyr = _core.euler_rates(gyr, Ts, roll_acc[0], pitch_acc[0])
     low = DiscreteFilter.from_lti(control.minreal(compensation("acc") * lowpass_acc(), verbose=False), Ts)
     high = DiscreteFilter.from_lti(control.minreal(compensation("acc") * highpass_gyro(), verbose=False), Ts)
     # the high-pass branch starts at rest on zero: its input is the gyro angle's change

@@ -1,2 +1,2 @@
-"""The estimator methods by name (registry) and the compiled steps of those that are not a
-sensor-frame LTI filter: the local-density Wiener filter, Luinge, Mahony, Tseng's adaptive switch."""
+"""The estimator methods by name (registry; their steps are the C core's, blocks/core/methods)
+and the model of the local-density Wiener filter (wiener_local)."""

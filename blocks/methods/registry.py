@@ -1,93 +1,60 @@
-"""Estimator methods by name: their documented parameters and their per-sample step.
+"""Estimator methods by name: their documented parameters (blocks.tuning), their earth-frame
+filter designs, and their per-sample step.
 
 A method is either an earth-frame LTI filter carried into the sensor frame
-(`sensor_frame`), or a compiled kernel of its own (`kernel`: a module with STATE_SIZE,
-coefficients, initial_state and run). Both are driven through a Stepper, which the batch
-path, the python-control block and the FMU share. Names are those of `attitude estimate
---method`.
+(blocks.filters.sensor_frame), or a kernel of its own in the C core (wiener's local noise
+densities, blocks.methods.wiener_local; Luinge's tilt Kalman filter; Mahony's filter;
+Tseng's adaptive filter, which switches between Mahony's and the `tseng` filter). The C core
+decides which runs and validates every parameter (attitude_fmu._core); the designs stay
+here as python-control transfer functions, and their zero-order holds (python-control's
+c2d, discrete_filter) are what the C core's step takes. Names are those of `attitude
+estimate --method`.
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from functools import lru_cache
 from typing import Callable, Mapping
 
-import numpy as np
-
+from attitude_fmu import _core
+from attitude_fmu.blocks import tuning
 from attitude_fmu.blocks.filters import earth_filters as ef
 from attitude_fmu.blocks.filters import tseng
-from attitude_fmu.blocks.filters.sensor_frame import DiscreteFilter, SensorFrameStepper, stepper_system
-from attitude_fmu.blocks.methods import luinge, mahony, tseng_adaptive, wiener_local
-from attitude_fmu.blocks.params import (
-    ANGLE_RAD,
-    FREQUENCY_RAD_S,
-    GRAVITY_M_S2,
-    GYRO_NOISE,
-    SLOSH,
-    TIME_S,
-    Param,
-    resolve_params,
-)
+from attitude_fmu.blocks.filters.sensor_frame import DiscreteFilter, stepper_system
+from attitude_fmu.blocks.params import Param
+
+NOMINAL_DELTA_V = tuning.NOMINAL_DELTA_V
 
 
 @dataclass(frozen=True)
 class Method:
-    """design gives the earth-frame filter of a sensor-frame method; kernel is the module
-    of a method with a step of its own. A method with both runs its kernel where
-    kernel_when(resolved params) is true (runs_kernel), its earth-frame filter otherwise."""
+    """design gives the earth-frame filter of a sensor-frame method (resolved params →
+    transfer function); mode_filter the earth-frame filter a kernel switches to where it
+    has one (tseng_adaptive's complementary mode)."""
 
     name: str
     summary: str
     params: tuple[Param, ...]
-    design: Callable[[Mapping[str, float | None]], control.TransferFunction] | None = None
-    kernel: object = None
-    kernel_when: Callable[[Mapping[str, float | None]], bool] = lambda p: True
+    design: Callable[[Mapping[str, float | None]], object] | None = None
+    mode_filter: Callable[[], object] | None = None
 
     def resolve(self, overrides: Mapping[str, float] | None = None) -> dict[str, float | None]:
-        """Defaults updated by overrides; unknown names and non-positive values are refused."""
-        return resolve_params(self.params, overrides, f"method {self.name!r}")
+        """Defaults updated by overrides; unknown names and values out of range are refused (the C core's)."""
+        return _core.resolve_params(self.name, overrides)
 
     def runs_kernel(self, p: Mapping[str, float | None]) -> bool:
         """Whether resolved parameters p select the method's own step over its filter."""
-        return self.kernel is not None and self.kernel_when(p)
+        return _core.method_kernel(self.name, {k: v for k, v in p.items() if v is not None}) != "sensor_frame"
 
     @property
     def is_sensor_frame(self) -> bool:
         return self.design is not None
 
-    def filter(self, overrides: Mapping[str, float] | None = None) -> control.TransferFunction:
+    def filter(self, overrides: Mapping[str, float] | None = None):
         """The earth-frame filter for these parameters (sensor-frame methods only)."""
         if self.design is None:
             raise ValueError(f"method {self.name!r} is not an earth-frame LTI filter")
         return self.design(self.resolve(overrides))
-
-
-NOMINAL_DELTA_V = 1.0  # m/s/√Hz: vigorous human motion (Rizun's Table 1), when delta_v is unset
-NOISE_PARAMS = (
-    Param("delta_n", math.radians(0.1), "rad/s/√Hz", "gyro noise density, one-sided (datasheet)", **GYRO_NOISE),
-    Param("delta_v", None, "m/s/√Hz",
-          f"slosh: density of the velocity of the motion (eq. 14); unset: {NOMINAL_DELTA_V:g} for the stationary filter",
-          **SLOSH),
-    Param("g", ef.STANDARD_GRAVITY, "m/s²", "magnitude of gravity", **GRAVITY_M_S2),
-)
-MAHONY_GAINS = (  # Mahony's filter, alone and in Tseng's adaptive switch
-    Param("k_P", 1.0, "1/s", "Mahony: proportional gain on the gravity-direction error", low=1e-6, high=1e4),
-    Param("k_I", 0.3, "1/s²", "Mahony: integral gain of the gyro-bias estimate; 0: no bias estimate", True, high=1e4),
-)
-LOCAL_NOISE_PARAMS = (
-    Param("stationary", 0.0, "1", "0: omega_g from noise densities measured over the last tau_noise s "
-          "(blocks.methods.wiener_local); 1, or omega_g, omega_c or delta_v given: the stationary filter",
-          True, high=1.0, choices=(0.0, 1.0)),
-    Param("scale_error", 0.005, "1", "rms of each element of the gyro's scale-factor and misalignment "
-          "error (datasheet)", True, high=1.0),
-    Param("omega_m", 10.0, "rad/s", "band limit of the motion (velocity and rate) in the local densities",
-          **FREQUENCY_RAD_S),
-    Param("tau_noise", 1.0, "s", "averaging time of the local densities", **TIME_S),
-    Param("tau_v", 1.0, "s", "time constant of the band-pass that turns the accelerometer into the "
-          "slosh velocity", **TIME_S),
-    Param("delta_v_min", 0.01, "m/s/√Hz", "floor of the local slosh density (rest)", **SLOSH),
-)
 
 
 def design_delta_v(p: Mapping[str, float | None]) -> float:
@@ -97,10 +64,6 @@ def design_delta_v(p: Mapping[str, float | None]) -> float:
 
 def _omega_g(p: Mapping[str, float | None]) -> float:
     return p["omega_g"] if p["omega_g"] is not None else ef.omega_g(p["delta_n"], design_delta_v(p), p["g"])
-
-
-def _wiener_is_local(p: Mapping[str, float | None]) -> bool:
-    return p["stationary"] == 0.0 and p["omega_g"] is None and p["omega_c"] is None and p["delta_v"] is None
 
 
 def _design_wiener(p):
@@ -114,111 +77,49 @@ def _design_first_order(p):
     return ef.first_order(ef.best_first_order_cutoff(_omega_g(p), p["omega_c"]))
 
 
+DESIGNS = {"wiener": _design_wiener, "tseng": lambda p: tseng.earth_filter(), "first_order": _design_first_order}
+MODE_FILTERS = {"tseng_adaptive": tseng.earth_filter}
+
 METHODS: dict[str, Method] = {
-    "wiener": Method(
-        "wiener",
-        "Rizun's optimal Wiener filter: eq. 34 (Butterworth) with omega_g from local noise densities; "
-        "with stationary=1 eq. 34 at fixed densities, or eq. 33 when omega_c is given",
-        NOISE_PARAMS + (
-            Param("omega_g", None, "rad/s", "break frequency; default sqrt(g·delta_n/delta_v), eq. 25",
-                  **FREQUENCY_RAD_S),
-            Param("omega_c", None, "rad/s", "band limit of the motion; given, eq. 33 replaces eq. 34",
-                  **FREQUENCY_RAD_S),
-        ) + LOCAL_NOISE_PARAMS,
-        _design_wiener,
-        kernel=wiener_local,
-        kernel_when=_wiener_is_local,
-    ),
-    "tseng": Method(
-        "tseng",
-        "Tseng's complementary filter (eqs. 6-11 with compensation), in the gyro-estimated earth frame",
-        (),
-        lambda p: tseng.earth_filter(),
-    ),
-    "tseng_adaptive": Method(
-        "tseng_adaptive",
-        "Tseng's adaptive filter: complementary filter, Mahony's filter while |acc| leaves g by > tol",
-        (
-            Param("tol", 0.5, "m/s²", "accelerometer norm's distance from g that switches to Mahony's filter",
-                  low=1e-4, high=400.0 * 9.80665),
-            *MAHONY_GAINS,
-            Param("g", ef.STANDARD_GRAVITY, "m/s²", "magnitude of gravity", **GRAVITY_M_S2),
-        ),
-        kernel=tseng_adaptive,
-    ),
-    "luinge": Method(
-        "luinge",
-        "Luinge's tilt Kalman filter: gyro orientation, 2-state KF on the tilt difference",
-        (
-            Param("delta_n", math.radians(0.1), "rad/s/√Hz", "gyro noise density (process noise of the tilt)",
-                  **GYRO_NOISE),
-            Param("tilt_sd", 0.05, "rad", "s.d. of the accelerometer's tilt (acceleration as noise)", **ANGLE_RAD),
-            Param("g", ef.STANDARD_GRAVITY, "m/s²", "magnitude of gravity (scales the gravity output)",
-                  **GRAVITY_M_S2),
-        ),
-        kernel=luinge,
-    ),
-    "mahony": Method(
-        "mahony",
-        "Mahony's complementary filter on SO(3) with gyro-bias estimation (IEEE TAC 53, 2008)",
-        MAHONY_GAINS + (
-            Param("g", ef.STANDARD_GRAVITY, "m/s²", "magnitude of gravity (scales the gravity output)",
-                  **GRAVITY_M_S2),
-        ),
-        kernel=mahony,
-    ),
-    "first_order": Method(
-        "first_order",
-        "Rizun §4.2: first-order low-pass in the gyro-estimated earth frame",
-        NOISE_PARAMS + (
-            Param("omega_g", None, "rad/s", "Wiener break frequency the best cut-off derives from", **FREQUENCY_RAD_S),
-            Param("omega_c", 10.0, "rad/s", "band limit of the motion (for the best cut-off)", **FREQUENCY_RAD_S),
-            Param("omega_f", None, "rad/s", "cut-off; default (omega_g⁴/(2·omega_c))^(1/3), the best",
-                  **FREQUENCY_RAD_S),
-        ),
-        _design_first_order,
-    ),
+    name: Method(name, summary, params, DESIGNS.get(name), MODE_FILTERS.get(name))
+    for name, (summary, params) in tuning.METHODS.items()
 }
 
 
 def method(name: str) -> Method:
     """The Method of that name (METHODS), or a ValueError naming the ones there are."""
-    try:
-        return METHODS[name]
-    except KeyError:
-        raise ValueError(f"unknown method {name!r}; available: {', '.join(METHODS)}") from None
+    if name not in METHODS:
+        _core.method_index(name)  # raises, naming them
+    return METHODS[name]
 
 
 @lru_cache(maxsize=64)
 def discrete_filter(name: str, params: tuple, Ts: float) -> DiscreteFilter:
-    """Method name's filter for params ((name, value) pairs) at sample time Ts (s), designed once."""
-    return DiscreteFilter.from_lti(method(name).filter(dict(params)), Ts)
-
-
-class KernelStepper:
-    """A method with a compiled kernel of its own: state and coefficients are 1-D arrays."""
-
-    def __init__(self, module, coef: np.ndarray):
-        self.module, self.coef = module, coef
-        self.state_names = list(module.STATE_NAMES)
-
-    def initial_state(self, acc0) -> np.ndarray:
-        return self.module.initial_state(self.coef, np.asarray(acc0, dtype=float))
-
-    def run(self, state, gyr, acc, gravity, quat) -> None:
-        self.module.run(state, self.coef, gyr, acc, gravity, quat)
-
-
-@lru_cache(maxsize=64)
-def stepper(name: str, params: tuple, Ts: float):
-    """The stepper of method name for params ((name, value) pairs) at sample time Ts (s)."""
+    """The earth-frame filter method name's C step runs for params ((name, value) pairs) held
+    over Ts (s): its design (a sensor-frame method) or the filter it switches to
+    (tseng_adaptive's), designed once."""
     m = method(name)
-    resolved = m.resolve(dict(params))
-    if not m.runs_kernel(resolved):
-        return SensorFrameStepper(discrete_filter(name, params, Ts))
-    if not (math.isfinite(Ts) and Ts > 0):
-        raise ValueError(f"sample time Ts must be a finite positive number of seconds, got {Ts!r}")
-    return KernelStepper(m.kernel, m.kernel.coefficients(resolved, Ts))
+    return DiscreteFilter.from_lti(m.filter(dict(params)) if m.design is not None else m.mode_filter(), Ts)
+
+
+@dataclass(frozen=True)
+class Holds:
+    """The source of a method's discrete filters for the C core (the zoh of
+    _core.Pipeline.at, _core.Stepper.of_method and _core.Online.step): called with a sample
+    time Ts (s), it gives discrete_filter(method, params, Ts)."""
+
+    method: str
+    params: tuple  # (name, value) pairs
+
+    def __call__(self, Ts: float) -> DiscreteFilter:
+        return discrete_filter(self.method, self.params, Ts)
+
+
+def stepper(name: str, params: tuple, Ts: float) -> _core.Stepper:
+    """The C core's step of method name for params ((name, value) pairs) at sample time Ts (s):
+    state = stepper.initial_state(gravity), then stepper.run(state, gyr, acc, gravity, quat)
+    over rows; stepper.state_names name the state's values."""
+    return _core.Stepper.of_method(name, dict(params), Ts, Holds(name, params))
 
 
 def estimator_system(method: str = "wiener", params: Mapping[str, float] | None = None, dt: float = 0.01,
@@ -226,6 +127,6 @@ def estimator_system(method: str = "wiener", params: Mapping[str, float] | None 
     """The method (a name of METHODS) with its params as a discrete python-control system of
     sample time dt (s), named name: inputs gyr_x..z (rad/s), acc_x..z (m/s²), outputs
     ghat_x..z (m/s²) and q_w..q_z, the batch path's estimate at each sample
-    (blocks.filters.sensor_frame.stepper_system; from the zero initial state it starts at
-    rest on its first sample)."""
+    (blocks.filters.sensor_frame.stepper_system; its state is the C step's state array; from
+    the zero initial state it starts at rest on its first sample)."""
     return stepper_system(stepper(method, tuple(sorted((params or {}).items())), dt), dt, name)

@@ -8,18 +8,17 @@ from dataclasses import dataclass
 from typing import Mapping
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
-from attitude_fmu.blocks.filters.sensor_frame import start_gravity, time_reversed
-from attitude_fmu.blocks.methods.registry import METHODS, KernelStepper
+from attitude_fmu import _core
+from attitude_fmu.blocks.methods.registry import METHODS
 from attitude_fmu.blocks.methods.registry import method as get_method
-from attitude_fmu.blocks.pipeline.causal import Pipeline, State, Step, at, configure, run, sample_timing
+from attitude_fmu.blocks.pipeline.causal import Pipeline, State, Step, at, configure, run
 from attitude_fmu.blocks.stages import heading as heading_stage
 from attitude_fmu.blocks.stages.delays import mag_delay
 from attitude_fmu.blocks.stages.gyro_offset import correct as correct_gyro
 from attitude_fmu.blocks.stages.hard_iron import back_dated
 from attitude_fmu.blocks.stages.heading import with_magnetometer
-from attitude_fmu.blocks.stages.timing import carry_forward_rows
+from attitude_fmu.blocks.stages.timing import carry_forward_rows, interval_ends, interval_means
 
 
 @dataclass
@@ -68,10 +67,13 @@ def check_mag(mag, n: int) -> np.ndarray:
     mag = np.ascontiguousarray(mag, dtype=float)
     if mag.shape != (n, 3):
         raise ValueError(f"mag must have the shape {(n, 3)}, got {mag.shape}")
+    finite = np.isfinite(mag)
+    if finite.all():  # (one pass where every sample is there)
+        return mag
     infinite = int(np.isinf(mag).sum())
     if infinite:
         raise ValueError(f"mag has {infinite} infinite values (NaN marks a missing sample)")
-    if np.isnan(mag).any(axis=1).all():
+    if not (finite[:, 0] & finite[:, 1] & finite[:, 2]).any():
         raise ValueError("mag has no sample without NaN: estimate without it (--heading gyro, or mag=None)")
     return mag
 
@@ -94,7 +96,7 @@ def check_options(method: str = "wiener", params: Mapping[str, float] | None = N
 def estimate(
     gyr, acc, fs: float, method: str = "wiener", params: Mapping[str, float] | None = None,
     initial_gravity=None, offline: bool = False, gyro_offset: bool = True, mag=None, latency: float = 0.0,
-    gyr_samples: str = "mean", acc_samples: str = "point",
+    gyr_samples: str = "mean", acc_samples: str = "point", threads: int | None = None,
 ) -> AttitudeEstimate:
     """Estimate attitude over a recording: gyr N×3 rad/s, acc N×3 m/s², fs in Hz.
 
@@ -120,6 +122,13 @@ def estimate(
     specific force at t_k) or "mean" (over the sample time before it, turned into the
     sensor frame at t_k first; blocks.stages.timing).
 
+    threads: at most this many threads for the causal pipeline (blocks.pipeline.causal.run;
+    the offline path runs on one): with two, its stages are pipelined over them (up to the
+    gyro offset, or with heading up to the method, on one; the rest on the other), the
+    outputs bit for bit those of one thread; None (automatic): two for 20 000 rows or more
+    where the process may run on two CPUs or more and the gyro offset or the heading runs.
+    Pass 1 where processes already use every CPU (one estimate per worker).
+
     offline: the batch-only additions (smoothed). The method's earth-frame filter runs
     forward, then backward over the forward estimate (for `wiener` the non-causal Wiener
     smoother, see blocks.filters.accuracy.smoother_mean_square_gravity_error); the gyro
@@ -133,14 +142,15 @@ def estimate(
     gyr, acc = check_imu(gyr, acc, fs)
     mag = None if mag is None else check_mag(mag, len(gyr))
     step = at(pipeline, 1.0 / fs)
-    start = int(np.argmax(acc.any(axis=1)))  # as OnlineEstimator, the stages wait for an accelerometer sample
+    # as OnlineEstimator, the stages wait for an accelerometer sample
+    start = 0 if acc[0].any() else int(np.argmax(acc.any(axis=1)))
     if not acc[start].any():
         raise ValueError("acc is zero throughout: no gravity to start on")
     if start:
         gyr, acc, mag = gyr[start:], acc[start:], None if mag is None else mag[start:]
     if offline:
         return held_before(smoothed(pipeline, step, gyr, acc, mag, initial_gravity), start)
-    rows = run(pipeline, step, State(), gyr, acc, mag, initial_gravity=initial_gravity)
+    rows = run(pipeline, step, State(), gyr, acc, mag, initial_gravity=initial_gravity, threads=threads)
     return held_before(AttitudeEstimate(rows.gravity, rows.quat, rows.offset, rows.mag_accepted, rows.mag_offset,
                                         rows.mag_delay, _mag_delay_source(pipeline, offline=False)), start)
 
@@ -164,26 +174,18 @@ def smoothed(pipeline: Pipeline, step: Step, gyr, acc, mag, initial_gravity=None
     """The offline estimate (see estimate): the pipeline's stages in their order, the
     gyro offset, the method and the heading each replaced by its offline form."""
     fs = 1.0 / step.Ts
-    gyr, acc = sample_timing(pipeline, step, State(), gyr, acc)
+    if pipeline.point_gyr:
+        gyr = interval_means(gyr)
+    if pipeline.mean_acc:
+        acc = interval_ends(gyr, acc, step.Ts)
     offset = None
     if pipeline.offset_params is not None:
         gyr, offset = correct_gyro(gyr, acc, fs, pipeline.offset_params, offline=True)
-    stepper = step.stepper
-    if initial_gravity is None:
-        initial_gravity = start_gravity(gyr[0], acc[0], step.Ts)
-    gyr_back = time_reversed(gyr)
-    if isinstance(stepper, KernelStepper):
-        # wiener's local densities: both passes run at the lower of the break frequencies
-        # estimated causally forward and backward in time
-        omega = np.minimum(_run_local(stepper, gyr, acc, initial_gravity)[1],
-                           _run_local(stepper, gyr_back, acc[::-1], acc[-1])[1][::-1])
-        forward = AttitudeEstimate(*_run_local(stepper, gyr, acc, initial_gravity, omega)[0])
-        backward = _run_local(stepper, gyr_back, forward.gravity[::-1], forward.gravity[-1], omega[::-1])[0][0]
-    else:
-        forward = _run(stepper, gyr, acc, initial_gravity)
-        backward = _run(stepper, gyr_back, np.ascontiguousarray(forward.gravity[::-1]), forward.gravity[-1]).gravity
-    gravity = backward[::-1].copy()
-    est = AttitudeEstimate(gravity, level_onto(forward.quat, gravity), offset)
+    # the method forward, then backward over its estimate (blocks/core/pipeline/offline.h); wiener's
+    # local densities: both passes at the lower of the break frequencies estimated forward and backward
+    est = AttitudeEstimate(np.empty((len(gyr), 3)), np.empty((len(gyr), 4)), offset)
+    _core.smooth(step.core, gyr, acc, None if initial_gravity is None else np.asarray(initial_gravity, dtype=float),
+                 est.gravity, est.quat)
     if mag is not None:
         _offline_heading(est, pipeline, mag, gyr, fs)
     if pipeline.latency:
@@ -208,34 +210,3 @@ def _offline_heading(est: AttitudeEstimate, pipeline: Pipeline, mag, gyr, fs: fl
             params["mag_delay"] = max(mag_delay(gyr, freed, fs) or 0.0, 0.0)
         est.quat, est.mag_accepted, _, est.mag_delay = with_magnetometer(quat, freed, fs,
                                                                          {**params, "mag_cal_time": 0.0})
-
-
-def _run_local(step, gyr, acc, initial_gravity, omega=None):
-    """((gravity, quat), break frequencies) of blocks.methods.wiener_local over gyr, acc; omega
-    (N, rad/s) imposes the break frequencies."""
-    state = step.initial_state(initial_gravity)
-    acc = np.ascontiguousarray(acc)
-    gravity, quat, used = np.empty_like(acc), np.empty((acc.shape[0], 4)), np.empty(acc.shape[0])
-    imposed = np.empty(0) if omega is None else np.ascontiguousarray(omega)
-    step.module.run_schedule(state, step.coef, np.ascontiguousarray(gyr), acc, gravity, quat, imposed, used)
-    return (gravity, quat), used
-
-
-def _run(step, gyr, acc, initial_gravity) -> AttitudeEstimate:
-    state = step.initial_state(initial_gravity)
-    gravity = np.empty_like(acc)
-    quat = np.empty((acc.shape[0], 4))
-    step.run(state, gyr, acc, gravity, quat)
-    return AttitudeEstimate(gravity, quat)
-
-
-def level_onto(quat, gravity) -> np.ndarray:
-    """Orientations (N×4) turned by the smallest earth-frame rotation that takes each
-    estimated up (gravity, sensor coordinates) onto earth up; heading is kept."""
-    rot = Rotation.from_quat(quat, scalar_first=True)
-    up = rot.apply(gravity / np.linalg.norm(gravity, axis=1, keepdims=True))
-    horizontal = np.hypot(up[:, 0], up[:, 1])
-    angle = np.arctan2(horizontal, up[:, 2])
-    scale = np.divide(angle, horizontal, out=np.zeros_like(angle), where=horizontal > 0)
-    correction = Rotation.from_rotvec(np.column_stack([up[:, 1] * scale, -up[:, 0] * scale, np.zeros_like(angle)]))
-    return (correction * rot).as_quat(scalar_first=True)

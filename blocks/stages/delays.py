@@ -7,9 +7,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from attitude_fmu.blocks.jit import kernel
-from attitude_fmu.blocks.quaternion import integrate_rates, quat_matrix, quat_multiply, rotvec_quat
-from attitude_fmu.blocks.stages.mag_delay import MAG_DELAY_REACH_S, MAG_DELAY_SIGMAS, MAG_SPAN_S
+from attitude_fmu import _core
+from attitude_fmu._core import MAG_DELAY_REACH_S, MAG_DELAY_SIGMAS, MAG_SPAN_S
 
 MAX_GRID = 100  # by default at most this many grid steps either way (steps of a sample or more)
 MAG_TURN = 0.05  # rad: spans over which the sensor turns less carry no delay
@@ -34,29 +33,6 @@ def best_shift(mismatch, reach: float, steps: int = MAX_GRID) -> float | None:
                                  options={"xatol": 1e-3}).x)
 
 
-@kernel()
-def carry_spans(quat, gyr, Ts, x0, x1, matrices):
-    """Per span j: matrices[j] = R_Δᵀ, R_Δ the sensor's turn from the fractional sample
-    index x0[j] to x1[j] (held at the ends). quat[k]: the sensor at
-    t_k integrated from gyr (rad/s, over Ts s each); between samples k and k + 1 it turns at
-    gyro sample k + 1's rate."""
-    last = quat.shape[0] - 1
-    for j in range(x0.shape[0]):
-        ends = []
-        for x in (x0[j], x1[j]):
-            x = min(max(x, 0.0), float(last))
-            k = min(int(x), last - 1)
-            f = (x - k) * Ts
-            ends.append(quat_multiply((quat[k, 0], quat[k, 1], quat[k, 2], quat[k, 3]),
-                                      rotvec_quat(f * gyr[k + 1, 0], f * gyr[k + 1, 1], f * gyr[k + 1, 2])))
-        q0, q1 = ends[0], ends[1]
-        turn_back = quat_multiply((q1[0], -q1[1], -q1[2], -q1[3]), q0)  # R_Δᵀ = q1⁻¹ ⊗ q0
-        R = quat_matrix(turn_back)
-        for i in range(3):
-            for c in range(3):
-                matrices[j, i, c] = R[3 * i + c]
-
-
 def mag_delay(gyr, mag, fs: float) -> float | None:
     """The magnetometer's delay behind the gyro (s), from the IMU's own data: a homogeneous
     field seen by a turning sensor is carried from one sample to the next by the gyro's
@@ -72,7 +48,7 @@ def mag_delay(gyr, mag, fs: float) -> float | None:
     ±MAG_DELAY_REACH_S, or where it lies within MAG_DELAY_SIGMAS standard errors (from the
     fit's curvature) of 0: a delay the data do not show (a sensor that turns too little for
     the field's noise, or none)."""
-    gyr, mag = np.asarray(gyr, dtype=float), np.asarray(mag, dtype=float)
+    gyr, mag = np.ascontiguousarray(gyr, dtype=float), np.asarray(mag, dtype=float)
     sampled = np.flatnonzero(np.isfinite(mag).all(axis=1))
     if len(sampled) < 2:
         return None
@@ -84,12 +60,13 @@ def mag_delay(gyr, mag, fs: float) -> float | None:
     spread = -(-len(k0) // MAG_MAX_SPANS)
     k0, k1 = k0[::spread], k1[::spread]
     quat = np.empty((len(gyr), 4))
-    integrate_rates(np.ascontiguousarray(gyr), 1.0 / fs, quat)  # quat[k]: the sensor at t_k
+    _core.integrate_rates(gyr, 1.0 / fs, quat)  # quat[k]: the sensor at t_k
 
     def carried(shift, keep):
-        """R_Δᵀ over each span of keep, the gyro shifted by shift samples."""
+        """R_Δᵀ over each span of keep, the gyro shifted by shift samples (the C core's
+        carry_spans: between samples k and k + 1 the sensor turns at gyro sample k + 1's rate)."""
         matrices = np.empty((len(keep), 3, 3))
-        carry_spans(quat, gyr, 1.0 / fs, k0[keep] - shift, k1[keep] - shift, matrices)
+        _core.carry_spans(quat, gyr, 1.0 / fs, k0[keep] - shift, k1[keep] - shift, matrices)
         return matrices
 
     def residuals(shift, keep):

@@ -20,101 +20,61 @@ This stage carries the estimate forward over the latency with the gyro: q ← q 
 and the up-vector into the sensor frame of that moment. L (s) counts in the convention
 above, after any conversion: a sensor whose point samples are taken d late has L = d.
 `attitude evaluate` measures L against an optical reference
-(systems.evaluation.evaluate.imu_latency). One kernel serves the batch path, the online step (FMU)
-and the python-control block.
+(systems.evaluation.evaluate.imu_latency). One step in the C core (blocks/core/stages/timing.c)
+serves the batch path, the online step (FMU) and the python-control block.
 """
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
+from attitude_fmu import _core
 from attitude_fmu.blocks.control_system import sample_system
-from attitude_fmu.blocks.jit import kernel
-from attitude_fmu.blocks.quaternion import quat_multiply, quat_rotate, rotvec_quat
 
-# relative difference below which two sample times are one: a master that keeps time in
-# integer nanoseconds, or sums steps in floating point, hands over Ts with rounding noise
-STEP_TOLERANCE = 1e-9
-MAX_LATENCY_S = 0.5  # the gyro's last rate is no guide to the orientation further ahead
-GYR_SAMPLES = ("mean", "point")  # the gyro's sample convention (module docstring)
-ACC_SAMPLES = ("point", "mean")  # the accelerometer's
+# the core's values: the relative difference below which two sample times are one (a master that
+# keeps time in integer nanoseconds, or sums steps in floating point, hands over Ts with rounding
+# noise), and same_step(Ts, reference), whether Ts is reference up to it
+STEP_TOLERANCE, same_step = _core.STEP_TOLERANCE, _core.same_step
+MAX_LATENCY_S = _core.MAX_LATENCY_S  # s: the gyro's last rate is no guide to the orientation further ahead
+GYR_SAMPLES, ACC_SAMPLES = _core.GYR_SAMPLES, _core.ACC_SAMPLES  # the sample conventions (above), the usual first
 
 
 def check_samples(gyr_samples: str, acc_samples: str = "point") -> tuple[str, str]:
     """(gyr_samples, acc_samples), refused unless in GYR_SAMPLES and ACC_SAMPLES."""
-    for name, value, allowed in (("gyr_samples", gyr_samples, GYR_SAMPLES), ("acc_samples", acc_samples, ACC_SAMPLES)):
-        if value not in allowed:
-            raise ValueError(f"{name} must be {' or '.join(map(repr, allowed))}, got {value!r}")
+    _core.check_samples(gyr_samples, acc_samples)
     return gyr_samples, acc_samples
-
-
-def same_step(Ts: float, reference: float) -> bool:
-    """Whether the sample time Ts (s) is reference (s) up to STEP_TOLERANCE."""
-    return abs(Ts - reference) <= STEP_TOLERANCE * reference
-
-
-def interval_mean(before, now):
-    """The mean rate over the sample time between two point samples of it (rad/s): the
-    trapezoid (ω_k−1 + ω_k)/2."""
-    return 0.5 * (before + now)
-
-
-def interval_means(gyr, before=None) -> np.ndarray:
-    """Point samples of the rate (N×3, rad/s, at t_k) as means over (t_k−1, t_k]
-    (interval_mean), a new array; before (3, rad/s): the point sample before the first,
-    None: the first sample, with nothing before it, stays."""
-    raw = np.asarray(gyr, dtype=float)
-    gyr = raw.copy()
-    gyr[1:] = interval_mean(raw[:-1], raw[1:])
-    if before is not None:
-        gyr[0] = interval_mean(np.asarray(before, dtype=float), raw[0])
-    return gyr
 
 
 def check_latency(latency: float) -> float:
     """latency (s) as a float, refused unless finite and within ±MAX_LATENCY_S."""
-    latency = float(latency)
-    if not (math.isfinite(latency) and abs(latency) <= MAX_LATENCY_S):
-        raise ValueError(f"latency must be a finite number of seconds within ±{MAX_LATENCY_S:g}, got {latency!r}")
-    return latency
+    return _core.check_latency(float(latency))
 
 
-@kernel(inline=True)
-def carry_forward(q, up, gyr, latency):
-    """(q ⊗ exp(gyr·latency), up in the sensor frame latency seconds later): q sensor →
-    earth (4-tuple), up (3-tuple, any length), gyr (rad/s, 3-tuple), latency (s)."""
-    dq = rotvec_quat(gyr[0] * latency, gyr[1] * latency, gyr[2] * latency)
-    return quat_multiply(q, dq), quat_rotate((dq[0], -dq[1], -dq[2], -dq[3]), up)
+def interval_means(gyr, before=None) -> np.ndarray:
+    """Point samples of the rate (N×3, rad/s, at t_k) as means over (t_k−1, t_k], the
+    trapezoid (ω_k−1 + ω_k)/2, a new array; before (3, rad/s): the point sample before the
+    first, None: the first sample, with nothing before it, stays."""
+    raw = np.asarray(gyr, dtype=float)
+    gyr = raw.copy()
+    gyr[1:] = 0.5 * (raw[:-1] + raw[1:])
+    if before is not None:
+        gyr[0] = 0.5 * (np.asarray(before, dtype=float) + raw[0])
+    return gyr
 
 
-@kernel()
-def carry_forward_rows(quat, gravity, gyr, latency):
-    """carry_forward on every row of quat (N×4) and gravity (N×3), in place; gyr N×3 (rad/s)."""
-    for k in range(quat.shape[0]):
-        q, up = carry_forward((quat[k, 0], quat[k, 1], quat[k, 2], quat[k, 3]),
-                              (gravity[k, 0], gravity[k, 1], gravity[k, 2]),
-                              (gyr[k, 0], gyr[k, 1], gyr[k, 2]), latency)
-        quat[k, 0], quat[k, 1], quat[k, 2], quat[k, 3] = q
-        gravity[k, 0], gravity[k, 1], gravity[k, 2] = up
+def carry_forward_rows(quat, gravity, gyr, latency: float) -> None:
+    """Every row of quat (N×4, sensor → earth) and gravity (N×3, any length), contiguous
+    float arrays, carried forward over latency (s) at the rates gyr (N×3, rad/s), in place:
+    q ⊗ exp(ω·latency), and the up-vector in the sensor frame latency seconds later."""
+    _core.carry_forward_rows(quat, gravity, np.ascontiguousarray(gyr, dtype=float), latency)
 
 
-@kernel(inline=True)
-def interval_end(gyr, acc, Ts):
-    """acc (3-tuple, m/s²), a mean over the sample time (t_k−1, t_k], in the sensor frame
-    at t_k: turned as carry_forward turns the up-vector over Ts/2 (s) at the step's mean
-    rate gyr (3-tuple, rad/s)."""
-    return carry_forward((1.0, 0.0, 0.0, 0.0), acc, gyr, 0.5 * Ts)[1]
-
-
-@kernel()
-def interval_ends(gyr, acc, Ts):
-    """interval_end on every row: accelerometer means (N×3, m/s²) in the sensor frame at
-    each sample's time, a new array; gyr N×3 (rad/s, the means over the same sample times)."""
+def interval_ends(gyr, acc, Ts: float) -> np.ndarray:
+    """Accelerometer means (N×3, m/s², each over the sample time Ts s before its sample) in the
+    sensor frame at each sample's time, a new array: turned as carry_forward_rows turns the
+    up-vector over Ts/2 at the step's mean rate gyr (N×3, rad/s)."""
+    acc = np.ascontiguousarray(acc, dtype=float)
     out = np.empty_like(acc)
-    for k in range(acc.shape[0]):
-        out[k, 0], out[k, 1], out[k, 2] = interval_end((gyr[k, 0], gyr[k, 1], gyr[k, 2]),
-                                                      (acc[k, 0], acc[k, 1], acc[k, 2]), Ts)
+    _core.interval_ends(np.ascontiguousarray(gyr, dtype=float), acc, Ts, out)
     return out
 
 
@@ -126,7 +86,7 @@ def latency_system(dt: float, latency: float, quat_inputs=("q_w", "q_x", "q_y", 
 
     def advance(state, u):
         quat, gravity = u[3:7].reshape(1, 4).copy(), u[7:10].reshape(1, 3).copy()
-        carry_forward_rows(quat, gravity, u[0:3].reshape(1, 3).copy(), latency)
+        _core.carry_forward_rows(quat, gravity, u[0:3].reshape(1, 3), latency)
         return state, np.concatenate([quat[0], gravity[0]])
 
     return sample_system(advance, [f"gyr_{a}" for a in "xyz"] + list(quat_inputs) + [f"ghat_{a}" for a in "xyz"],

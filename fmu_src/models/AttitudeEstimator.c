@@ -1,7 +1,8 @@
 /* AttitudeEstimator.c: the model of the native AttitudeEstimator.fmu: its variables
  * (AttitudeEstimator_variables.h, generated from fmu_src/variables.py) onto the C core's online
  * estimator (core/pipeline/online.h).
- * Python twin: fmu_src/AttitudeEstimator.py (the same checks, messages and statuses). */
+ * fmu_src/AttitudeEstimator.py is the pythonfmu model of the same variables (the same checks,
+ * messages and statuses). */
 #include <math.h>
 #include <string.h>
 
@@ -63,7 +64,7 @@ static fmi2Status initialise(Fmi2Instance *instance) {
         config.params[k] = isnan(value) || value == v->start ? NAN : value;
     }
     if (af_online_init(&model->estimator, &config, message, sizeof message) != 0 ||
-        af_online_discretise(&model->estimator, r[REAL_Ts], message, sizeof message) != 0) {
+        af_online_discretise(&model->estimator, r[REAL_Ts], NULL, message, sizeof message) != 0) {
         fmi2_log(instance, fmi2Error, "invalid parameter: %s", message);
         return fmi2Error;
     }

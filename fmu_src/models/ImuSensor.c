@@ -1,15 +1,16 @@
 /* ImuSensor.c: the model of the native ImuSensor.fmu: its variables (ImuSensor_variables.h,
- * generated from fmu_src/simulation_variables.py) onto the simulation's sensor model (sim/sensor.h),
- * delay line (sim/delay_line.h) and noise streams (sim/noise.h): step k draws sample k of the
+ * generated from fmu_src/simulation_variables.py) onto the simulation's sensor model (sensor.h),
+ * delay line (delay_line.h) and noise streams (noise.h): step k draws sample k of the
  * streams SENSOR and MAGNETOMETER of `seed`, as ImuModel.apply and apply_mag draw them.
- * Python twin: fmu_src/ImuSensor.py (the same checks, messages and statuses). */
+ * The pythonfmu ImuSensor (fmu_src/ImuSensor.py) runs the same C core with the same checks,
+ * messages and statuses. */
 #include <stdint.h>
 
 #include "ImuSensor_variables.h"
 #include "messages.h"
-#include "sim/delay_line.h"
-#include "sim/noise.h"
-#include "sim/sensor.h"
+#include "delay_line.h"
+#include "noise.h"
+#include "sensor.h"
 #include "stages/timing.h"
 
 #define MESSAGE_SIZE 512

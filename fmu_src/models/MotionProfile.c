@@ -1,27 +1,22 @@
 /* MotionProfile.c: the model of the native MotionProfile.fmu: its variables (MotionProfile_variables.h,
  * generated from fmu_src/simulation_variables.py) onto the simulation's motions: the human motion's
- * stream (sim/human_motion.h) and the closed forms (sim/closed_form.h). doStep(t, h) outputs the
+ * stream (human_motion.h) and the closed forms (closed_form.h). doStep(t, h) outputs the
  * interval (t, t+h]. A profile's parameters are the Real parameters named <profile>_<parameter>, in
- * the table's order, which is the Python profile's.
- * Python twin: fmu_src/MotionProfile.py (the same checks, messages and statuses). */
+ * the order of systems/simulation/profile_table.py.
+ * The pythonfmu MotionProfile (fmu_src/MotionProfile.py) runs the same C core with the same checks,
+ * messages and statuses. */
 #include <math.h>
 #include <string.h>
 
 #include "MotionProfile_variables.h"
 #include "messages.h"
-#include "quaternion.h"
-#include "sim/closed_form.h"
-#include "sim/earth_field.h"
-#include "sim/human_motion.h"
-#include "sim/noise.h"
+#include "closed_form.h"
+#include "earth_field.h"
+#include "human_motion.h"
+#include "noise.h"
 
 #define MESSAGE_SIZE 1024
-#define HUMAN N_CLOSED_FORMS /* the profile number of the human motion, after the closed forms */
-
-/* the profiles by number: the closed forms in sim/closed_form.h's order, then the human motion */
-static const char *const PROFILE_NAMES[N_CLOSED_FORMS + 1] = {
-    "lever_arm", "incline", "coning", "sine_rotation", "step_rotation", "linear_motion", "offset_rotation", "human",
-};
+#define HUMAN "human" /* the human motion's profile name; the others are closed forms */
 
 typedef struct {
     int human; /* the human motion's stream, else the closed form */
@@ -45,7 +40,7 @@ static int profile_values(Fmi2Instance *instance, const char *profile, double va
             return -1;
         }
         if (n == CLOSED_FORM_MAX_PARAMS) {
-            fmi2_log(instance, fmi2Error, "profile %s has more parameters than sim/closed_form.h holds", profile);
+            fmi2_log(instance, fmi2Error, "profile %s has more parameters than closed_form.h holds", profile);
             return -1;
         }
         values[n++] = value;
@@ -57,13 +52,12 @@ static fmi2Status initialise(Fmi2Instance *instance) {
     Model *model = instance->state;
     const char *name = instance->strings[STRING_profile];
     char message[MESSAGE_SIZE], repr[FMI2_STRING_SIZE + 8];
-    int profile = 0;
-    while (profile <= HUMAN && strcmp(PROFILE_NAMES[profile], name) != 0) profile++;
-    if (profile > HUMAN) {
-        char available[256] = "human"; /* in the order of systems.simulation.motion.PROFILES */
+    int profile = closed_form_profile(name), human = strcmp(name, HUMAN) == 0;
+    if (profile < 0 && !human) {
+        char available[256] = HUMAN; /* in the order of systems/simulation/profile_table.py */
         for (int k = 0; k < N_CLOSED_FORMS; k++) {
             strncat(available, ", ", sizeof available - strlen(available) - 1);
-            strncat(available, PROFILE_NAMES[k], sizeof available - strlen(available) - 1);
+            strncat(available, CLOSED_FORM_NAMES[k], sizeof available - strlen(available) - 1);
         }
         fmi2_log(instance, fmi2Error, "invalid parameter: unknown profile %s; available: %s",
                  str_repr(name, repr, sizeof repr), available);
@@ -72,8 +66,8 @@ static fmi2Status initialise(Fmi2Instance *instance) {
     double p[CLOSED_FORM_MAX_PARAMS] = {0.0};
     if (profile_values(instance, name, p) != 0) return fmi2Error;
     double g = instance->reals[REAL_g];
-    model->human = profile == HUMAN;
-    if (model->human) {
+    model->human = human;
+    if (human) {
         HumanParams params = {p[0], p[1], p[2], p[3], g};
         uint64_t seed;
         if (human_check(&params, message, sizeof message) != 0 ||
@@ -98,9 +92,7 @@ static fmi2Status step(Fmi2Instance *instance, fmi2Real t, fmi2Real h) {
     else closed_form_at(&model->closed, t + h, h, out, out + 3, out + 6);
     for (int i = 0; i < 3; i++) r[REAL_omega_x + i] = out[i], r[REAL_f_x + i] = out[3 + i];
     for (int i = 0; i < 4; i++) r[REAL_qt_w + i] = out[6 + i];
-    const double earth[3] = EARTH_FIELD_UT;
-    Vec3 m = quat_rotate((Quat){out[6], -out[7], -out[8], -out[9]}, (Vec3){earth[0], earth[1], earth[2]});
-    r[REAL_m_x] = m.x, r[REAL_m_y] = m.y, r[REAL_m_z] = m.z;
+    earth_field_in_sensor(out + 6, &r[REAL_m_x]);
     return fmi2OK;
 }
 

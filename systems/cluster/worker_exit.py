@@ -5,7 +5,7 @@ interpreter shutdown after its worker has closed: the nanny's target returns and
 multiprocessing calls sys.exit. Two things go wrong there. pythonfmu's export library can
 crash the process (systems.fmi.cosim.fmus_loaded), after its results were sent but with a
 signal for exit status, which a nanny logs and a batch system counts as a failed job. And
-finalising an interpreter that holds numba, scipy and python-control takes seconds on a
+finalising an interpreter that holds scipy, python-control and dask takes seconds on a
 loaded machine, past the 4 s a nanny waits before it kills the process. WorkerExit, a
 worker plugin the client registers on every worker, ends such a process right away, with
 status 0, as the console script and the test session end theirs.

@@ -118,12 +118,11 @@ def _fmpy_rounds(fmus: dict, inputs, steps: int, repeat: int, progress: bool) ->
 
 def _c_host_rounds(fmus: dict, inputs, repeat: int, tmp: Path, progress: bool) -> dict:
     """Best µs per step of each extracted FMU (name → (md, folder)) in a C host with no
-    Python in its process (systems/evaluation/fmi_bench.c), each in a process of its own."""
-    from attitude_fmu.systems.fmi.native import FMI_HEADERS, compiler
+    Python in its process (systems/evaluation/fmi_bench.c, as the package's build made it),
+    each in a process of its own."""
+    from attitude_fmu.systems.fmi.native import built
 
-    host, data = tmp / "fmi_bench", tmp / "inputs.bin"
-    subprocess.run([*compiler(), "-std=c99", "-O2", f"-I{FMI_HEADERS}", "-o", str(host),
-                    str(Path(__file__).with_name("fmi_bench.c")), "-ldl"], check=True, capture_output=True, text=True)
+    host, data = built("fmi_bench"), tmp / "inputs.bin"
     np.ascontiguousarray(inputs, dtype=float).tofile(data)
     result = {}
     for name, (md, folder) in fmus.items():
@@ -171,7 +170,8 @@ def bench_fmu(steps: int = 5000, repeat: int = 5, progress: bool = True) -> dict
             name = path.stem if path.parent == Path(tmp) else f"native/{path.stem}"
             fmus[name] = (read_model_description(path), extract(path))
         if set(fmus) != {*names, *(f"native/{n}" for n in names)}:
-            raise RuntimeError("attitude bench --fmu needs the native FMUs: a C compiler (see the warning above)")
+            raise RuntimeError("attitude bench --fmu needs the native FMUs, which the package's build makes "
+                               "(see the warning above)")
         per_step = _fmpy_rounds(fmus, inputs, steps, repeat, progress)
         c_host = _c_host_rounds({n: fmus[n] for n in ("native/AttitudeEstimator", "AttitudeEstimator")}, inputs,
                                 repeat, Path(tmp), progress)

@@ -92,18 +92,19 @@ def method_label(method: str, offline: bool) -> str:
 
 def evaluate_recording(rec: Recording, method: str = "wiener", params=None, offline: bool = False,
                        gyro_offset: bool = True, use_mag: bool = True, latency: float = 0.0,
-                       peers: bool = True) -> dict:
+                       peers: bool = True, threads: int | None = None) -> dict:
     """{method label: {metric: value}} for one recording; with a magnetometer (and use_mag)
     the method's heading comes from it, and vqf's 9D estimate is added as "vqf_9d". A
     reference that fits far better in another order is noted in rec.notes
     (reference_order_note).
     latency (s): every estimate, the peers' too, is carried forward over the IMU's delay
-    (blocks.stages.timing; the peers' with the raw gyro). peers=False: the method's alone."""
+    (blocks.stages.timing; the peers' with the raw gyro). peers=False: the method's alone.
+    threads: the estimate's (blocks.pipeline.batch.estimate; None: its own choice)."""
     rec.evaluated()  # refuses a recording without a usable reference before any work
     label = method_label(method, offline)
     mag = rec.mag if use_mag else None
     est = estimate(rec.gyr, rec.acc, rec.fs, method, params, offline=offline, gyro_offset=gyro_offset, mag=mag,
-                   latency=latency)
+                   latency=latency, threads=threads)
     gyr, acc = np.ascontiguousarray(rec.gyr), np.ascontiguousarray(rec.acc)
 
     def peer(quat):
@@ -146,6 +147,7 @@ class Setup:
     latency: float = 0.0
     gyr_samples: str = "mean"
     acc_samples: str = "point"
+    threads: int | None = None  # the estimate's (job_threads)
 
     def check(self) -> None:
         """Refuse the options before any file is read (blocks.pipeline.batch.check_options)."""
@@ -172,10 +174,16 @@ def evaluate_file(path, setup: Setup, peers: bool = True) -> dict:
     the method's label only, imu_latency_s None), as a sweep needs them."""
     rec = read_prepared(path, setup)
     table = evaluate_recording(rec, setup.method, setup.params, setup.offline, setup.gyro_offset, setup.use_mag,
-                               setup.latency, peers)
+                               setup.latency, peers, setup.threads)
     notes = rec.notes + ([f"{rec.name}: no movement flag; errors over every sample with a reference"]
                          if rec.movement is None else [])
     return {"table": table, "imu_latency_s": imu_latency(rec) if peers else None, "notes": notes}
+
+
+def job_threads(jobs: Jobs) -> int | None:
+    """The threads of each job's estimate: 1 where the jobs run on Dask workers (a process on
+    every core already), None (the estimate's own choice) where they run in this process."""
+    return 1 if jobs.scheduler is not None or jobs.workers > 1 else None
 
 
 def recording_names(paths) -> list[str]:
@@ -215,10 +223,10 @@ def evaluate(paths, method: str = "wiener", params=None, offline: bool = False, 
     this process, a bar when progress); results are those of the serial run, in the files'
     order. progress also prints how each file was read where it matters (time stamps, no
     movement flag)."""
-    setup = Setup(method, params, offline, gyro_offset, use_mag, start_in_movement, read_options, latency,
-                  gyr_samples, acc_samples)
-    setup.check()
     jobs = jobs or Jobs(bar=progress)
+    setup = Setup(method, params, offline, gyro_offset, use_mag, start_in_movement, read_options, latency,
+                  gyr_samples, acc_samples, job_threads(jobs))
+    setup.check()
     names = recording_names(paths)
     results = jobs.map(evaluate_file, [(str(Path(path).absolute()), setup) for path in paths], list(map(str, paths)),
                        "recordings")

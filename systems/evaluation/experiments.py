@@ -16,7 +16,7 @@ from attitude_fmu.blocks.filters.sensor_frame import DiscreteFilter
 from attitude_fmu.blocks.methods.registry import method as get_method
 from attitude_fmu.blocks.pipeline.batch import AttitudeEstimate, estimate
 from attitude_fmu.systems.cluster.jobs import Failure, Jobs
-from attitude_fmu.systems.simulation.motion import HumanMotion, Motion, incline_oscillation, steady_lever_arm
+from attitude_fmu.systems.simulation.motion import HumanMotion, Motion, profile
 from attitude_fmu.systems.simulation.sensor_model import ImuModel
 
 PAPER_G = 9.8  # m/s²: the g that reproduces every printed digit of Table 1
@@ -145,7 +145,7 @@ def lever_arm_bias(rate: float = 2.0, radius: float = 0.2, duration: float = 600
 
     Both use the same Butterworth (eq. 34); ideal sensors. Angles in degrees.
     """
-    motion = steady_lever_arm(rate, radius, g=g).generate(duration, fs)
+    motion = profile("lever_arm").motion({"rate": rate, "radius": radius}, g=g).generate(duration, fs)
     params = {"delta_n": delta_n, "delta_v": delta_v, "g": g}
     filt = get_method("wiener").filter(params)
     start = int(settle_time(filt) * fs)
@@ -171,7 +171,7 @@ def incline_angle_bias(duration: float = 600.0, fs: float = 100.0, frequency: fl
     Pitch is the angle of the sensor x axis above the horizontal, from the measured (or
     estimated) up-vector u as atan2(u_x, √(u_y² + u_z²)); degrees.
     """
-    motion = incline_oscillation(frequency=frequency, g=g).generate(duration, fs)
+    motion = profile("incline").motion({"frequency": frequency}, g=g).generate(duration, fs)
     params = {"delta_n": delta_n, "delta_v": delta_v, "g": g}
     filt = get_method("wiener").filter(params)
     start = int(settle_time(filt) * fs)

@@ -18,6 +18,7 @@ from attitude_fmu.systems.evaluation.evaluate import (
     METRICS,
     Setup,
     evaluate_file,
+    job_threads,
     method_label,
     recording_names,
 )
@@ -98,6 +99,7 @@ def sweep(paths, grid, setup: Setup | None = None, score_on=(), by: str = "incli
         raise ValueError(f"by must be one of {', '.join(BY)}, got {by!r}")
     _check(paths, grid, setup, score_on)
     jobs = jobs or Jobs(bar=progress)
+    setup = replace(setup, threads=job_threads(jobs))
     label = method_label(setup.method, setup.offline)
     combos, names = combinations(grid), recording_names(paths)
     flat = _runs(jobs, [(path, _with(setup, combo), f"{path} with {_text(combo)}")

@@ -1,27 +1,28 @@
 """Building the project's FMUs (FMI 2.0 co-simulation): those of fmu_src/ with pythonfmu
-into DIR/, and the native ones, in C with no Python (systems.fmi.native), into DIR/native/, the
-native estimator also as FMI 3.0 co-simulation (systems.fmi.fmi3) into DIR/native/fmi3/.
+into DIR/; the native ones, in C with no Python, which the package's build made
+(systems.fmi.native), copied into DIR/native/, the native estimator as FMI 3.0 co-simulation
+(systems.fmi.fmi3) into DIR/native/fmi3/.
 
-Each FMU carries in its resources the modules of attitude_fmu that its fmu_src adapter
-imports (carried_files), so it runs where only numpy, scipy, control and pythonfmu are
-installed, and carries no command line, plots, benchmarks or build code; its packages have
-no __init__.py there, so that FMUs of one build share them (fmu_support.foreign_code).
+Each pythonfmu FMU carries in its resources the modules of attitude_fmu that its fmu_src
+adapter imports (carried_files), the compiled extension attitude_fmu._core among them, so it
+runs where only numpy, scipy, control and pythonfmu are installed, and carries no command
+line, plots, benchmarks or build code; its packages have no __init__.py there, so that FMUs
+of one build share them (fmu_support.foreign_code).
 
-On Linux (and macOS, not yet tried there) the FMU's binary is fmu_src/fmi2_guard.c,
-compiled here with the C compiler ($CC, else Python's, else cc); it loads pythonfmu's library from beside it and
+On Linux (and macOS, not yet tried there) the FMU's binary is fmu_src/fmi2_guard.c as the
+package's build made it (built/fmi2_guard.so); it loads pythonfmu's library from beside it and
 gives the FMI status codes their meaning (a logged error ends the call in fmi2Error); in an
 importer without Python it first starts the interpreter recorded by python_environment.
-Without a compiler the FMUs keep pythonfmu's binary, and a warning says what that costs.
+Where the guard is not built the FMUs keep pythonfmu's binary, and a warning says what that costs.
 """
 from __future__ import annotations
 
 import ast
 import hashlib
+import importlib.machinery
 import json
-import shlex
 import shutil
 import site
-import subprocess
 import sys
 import sysconfig
 import tempfile
@@ -31,7 +32,7 @@ from pathlib import Path
 import attitude_fmu
 from attitude_fmu.fmu_src.fmu_support import PACKAGE, code_digest
 from attitude_fmu.systems.fmi import fmi3
-from attitude_fmu.systems.fmi.native import NATIVE_NAMES, build_native_fmus, compiler, is_current
+from attitude_fmu.systems.fmi.native import NATIVE_NAMES, NotBuilt, built, copy_fmus, is_current
 
 FMU_NAMES = ("AttitudeEstimator", "ImuSensor", "MotionProfile")
 PACKAGE_DIR = Path(attitude_fmu.__file__).resolve().parent
@@ -42,18 +43,25 @@ VARIABLE_TYPES = "resources/variable_types.txt"  # in the FMU: see variable_type
 
 
 def _module_file(module: str) -> Path | None:
-    """The source file of an attitude_fmu module or package (dotted name), None if there is none."""
+    """The file of an attitude_fmu module or package (dotted name): its source, or a compiled
+    extension module's library (attitude_fmu._core); None if there is none."""
     parts = module.split(".")[1:]
     package = PACKAGE_DIR.joinpath(*parts, "__init__.py")
     if package.is_file():
         return package
-    return PACKAGE_DIR.joinpath(*parts).with_suffix(".py") if parts and PACKAGE_DIR.joinpath(*parts).with_suffix(".py").is_file() else None
+    if not parts:
+        return None
+    stem = PACKAGE_DIR.joinpath(*parts)
+    return next((path for suffix in (".py", *importlib.machinery.EXTENSION_SUFFIXES)
+                 if (path := stem.with_name(stem.name + suffix)).is_file()), None)
 
 
 def _imports(path: Path, module: str) -> set[str]:
     """The attitude_fmu modules the file of module imports anywhere in it (functions
     included), except under `if TYPE_CHECKING:`; `from package import name` counts the
-    submodule name where there is one, else the package."""
+    submodule name where there is one, else the package. An extension module imports none."""
+    if path.suffix != ".py":
+        return set()
     tree = ast.parse(path.read_text(encoding="utf-8"))
     skipped = {id(n) for node in ast.walk(tree) if isinstance(node, ast.If) and ast.unparse(node.test) == "TYPE_CHECKING"
                for child in node.body for n in ast.walk(child)}
@@ -93,10 +101,11 @@ def carried_files(name: str) -> list[str]:
 
 
 def source_fingerprint(name: str) -> str:
-    """SHA-256 over the sources an FMU is built from: its adapter, the modules it carries
-    (carried_files) and fmi2_guard.c."""
+    """SHA-256 over what an FMU is built from: its adapter, the modules it carries
+    (carried_files, the extension module's library included) and the guard's binary (guard_binary)."""
     digest = hashlib.sha256(code_digest(PACKAGE_DIR, [f"fmu_src/{name}.py", *carried_files(name)]).encode())
-    digest.update((SOURCE_DIR / "fmi2_guard.c").read_bytes())
+    guard = guard_binary(log=lambda message: None)
+    digest.update(guard.read_bytes() if guard is not None else b"\0no guard")
     return digest.hexdigest()
 
 
@@ -134,34 +143,33 @@ def built_from(fmu) -> str | None:
 
 
 def build_fmus(out, names=FMU_NAMES, native=NATIVE_NAMES, fmi3_names=fmi3.FMI3_NAMES) -> list[Path]:
-    """Build the named pythonfmu FMUs into the directory out, the named native ones into
-    out/native and the named FMI 3.0 ones into out/native/fmi3 (none without a C compiler: a
-    warning says so); returns their paths."""
+    """Build the named pythonfmu FMUs into the directory out, and copy the named native ones
+    into out/native and the named FMI 3.0 ones into out/native/fmi3 (none where the package's
+    build did not make them: a warning says so); returns their paths."""
     from pythonfmu.builder import FmuBuilder
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    built = []
+    built_fmus = []
+    guard = guard_binary() if names else None
     with tempfile.TemporaryDirectory(prefix="attitude_fmu_") as tmp:
         for name in names:
-            # only what the adapter imports, as namespace packages (fmu_support.foreign_code);
-            # no compiled files travel
+            # only what the adapter imports, as namespace packages (fmu_support.foreign_code)
             staged = Path(tmp) / name / PACKAGE
             for relative in (f for f in carried_files(name) if not f.endswith("__init__.py")):
                 (staged / relative).parent.mkdir(parents=True, exist_ok=True)
                 shutil.copy2(PACKAGE_DIR / relative, staged / relative)
-            built.append(Path(FmuBuilder.build_FMU(SOURCE_DIR / f"{name}.py", dest=out, project_files=[staged],
-                                                   needsExecutionTool="false", canGetAndSetFMUstate="true",
-                                                   canSerializeFMUstate="true")))
-        guard = compile_guard(Path(tmp) / "fmi2_guard.so")
-        for path in built:
-            if guard is not None:
-                install_guard(path, guard)
-            with zipfile.ZipFile(path, "a", zipfile.ZIP_DEFLATED) as zf:
-                zf.writestr(FINGERPRINT, source_fingerprint(path.stem) + "\n")
-                zf.writestr(PYTHON_ENVIRONMENT, python_environment())
-                zf.writestr(VARIABLE_TYPES, variable_types(zf.read("modelDescription.xml")))
-    return built + build_native_fmus(out / "native", native) + fmi3.build_fmi3_fmus(out / "native" / "fmi3", fmi3_names)
+            built_fmus.append(Path(FmuBuilder.build_FMU(SOURCE_DIR / f"{name}.py", dest=out, project_files=[staged],
+                                                        needsExecutionTool="false", canGetAndSetFMUstate="true",
+                                                        canSerializeFMUstate="true")))
+    for path in built_fmus:
+        if guard is not None:
+            install_guard(path, guard)
+        with zipfile.ZipFile(path, "a", zipfile.ZIP_DEFLATED) as zf:
+            zf.writestr(FINGERPRINT, source_fingerprint(path.stem) + "\n")
+            zf.writestr(PYTHON_ENVIRONMENT, python_environment())
+            zf.writestr(VARIABLE_TYPES, variable_types(zf.read("modelDescription.xml")))
+    return built_fmus + copy_fmus(out / "native", native) + fmi3.copy_fmi3_fmus(out / "native" / "fmi3", fmi3_names)
 
 
 GUARD_PLATFORMS = {"linux": "linux64", "darwin": "darwin64"}  # sys.platform prefix → FMI binaries folder
@@ -173,23 +181,19 @@ def guard_platform() -> str | None:
     return next((v for k, v in GUARD_PLATFORMS.items() if sys.platform.startswith(k)), None)
 
 
-def compile_guard(out: Path, log=lambda m: print(m, file=sys.stderr)) -> Path | None:
-    """Compile fmi2_guard.c into the shared library out; None (with a warning) where it cannot be."""
-    platform = guard_platform()
-    command = [*compiler(), "-shared", "-fPIC", "-O2", "-fvisibility=hidden", "-o", str(out),
-               str(SOURCE_DIR / "fmi2_guard.c"), "-ldl", "-lpthread"]
+def guard_binary(log=lambda m: print(m, file=sys.stderr)) -> Path | None:
+    """fmi2_guard.c as the package's build made it (built/fmi2_guard.so); None (with a warning)
+    where there is none for this platform."""
     consequence = ("the FMUs keep pythonfmu's own binary: an invalid parameter ends in fmi2Discard "
                    "instead of fmi2Error, and log messages need debug logging on")
-    if platform is None:
+    if guard_platform() is None:
         log(f"warning: no FMI guard for platform {sys.platform}; {consequence}")
         return None
     try:
-        subprocess.run(command, check=True, capture_output=True, text=True)
-    except (OSError, subprocess.CalledProcessError) as exc:
-        detail = getattr(exc, "stderr", None) or exc
-        log(f"warning: cannot compile fmi2_guard.c ({shlex.join(command)}: {detail}); {consequence}")
+        return built("fmi2_guard.so")
+    except NotBuilt as exc:
+        log(f"warning: {exc}; {consequence}")
         return None
-    return out
 
 
 def install_guard(fmu: Path, guard: Path) -> None:
@@ -214,7 +218,7 @@ def ensure_built(fmu_dir, rebuild: bool = False, log=print) -> Path:
     """The directory holding every FMU, building those missing or built from other sources
     than this installation's (or all with rebuild): FMUs loaded into one process share the
     first-loaded copy of the project's modules, so the ones run must match the code; a
-    native FMU's guid is a digest of its sources (systems.fmi.native.is_current)."""
+    native FMU is current where its guid is that of the package's (systems.fmi.native.is_current)."""
     fmu_dir = Path(fmu_dir)
     names = {n: fmu_dir / f"{n}.fmu" for n in FMU_NAMES}
     names.update({f"native/{n}": fmu_dir / "native" / f"{n}.fmu" for n in NATIVE_NAMES})

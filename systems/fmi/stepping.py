@@ -1,27 +1,17 @@
-"""The co-simulation master's stepping loop in C (systems/fmi/stepping.c), compiled with the
-system's C compiler once per user and source (kept in the per-user cache, blocks.jit.user_cache),
-for systems.fmi.cosim: with native FMUs a step then costs what the FMUs compute rather than a
-Python loop of FMI calls through fmpy (verify's human × wiener, 120 s at 50 Hz on the native
-chain: 0.09 s of CPU against 0.5 s, setup included)."""
+"""The co-simulation master's stepping loop in C (systems/fmi/stepping.c), as the package's
+build made it (built/stepping.so, systems.fmi.native), for systems.fmi.cosim: with native FMUs
+a step then costs what the FMUs compute rather than a Python loop of FMI calls through fmpy
+(verify's human × wiener, 120 s at 50 Hz on the native chain: 0.09 s of CPU against 0.5 s,
+setup included)."""
 from __future__ import annotations
 
-import atexit
 import ctypes
-import hashlib
-import os
-import shutil
-import subprocess
-import sysconfig
-import tempfile
 from functools import cache
-from pathlib import Path
 
 import numpy as np
 
-from attitude_fmu.blocks.jit import user_cache
-from attitude_fmu.systems.fmi.native import FMI_HEADERS, compiler
+from attitude_fmu.systems.fmi.native import NotBuilt, built
 
-SOURCE = Path(__file__).with_name("stepping.c")
 _VR = ctypes.c_uint
 _FUNCTIONS = ("fmi2DoStep", "fmi2SetReal", "fmi2GetReal", "fmi2GetBoolean")
 
@@ -36,42 +26,13 @@ class SteppedComponent(ctypes.Structure):
                 ("n_booleans", ctypes.c_size_t), ("boolean_vr", ctypes.POINTER(_VR)), ("boolean_at", ctypes.c_size_t)]
 
 
-def _command() -> list[str]:
-    return [*compiler(), "-std=c99", "-O2", "-fPIC", "-shared", f"-I{FMI_HEADERS}"]
-
-
-def library_path() -> Path:
-    """Where the compiled loop is kept: the per-user cache, under a digest of the platform,
-    the compiler's command, the source and the FMI headers it includes (a folder of its own
-    where the cache cannot be written, removed at exit)."""
-    digest = hashlib.sha256("\0".join([sysconfig.get_platform(), *_command()]).encode() + SOURCE.read_bytes())
-    for header in sorted(FMI_HEADERS.glob("fmi2*.h")):
-        digest.update(header.read_bytes())
-    try:
-        folder = user_cache() / "c"
-        folder.mkdir(parents=True, exist_ok=True)
-        if not os.access(folder, os.W_OK):
-            raise PermissionError(folder)
-    except (OSError, RuntimeError):
-        folder = Path(tempfile.mkdtemp(prefix="attitude_stepping_"))
-        atexit.register(shutil.rmtree, folder, True)
-    return folder / f"stepping-{digest.hexdigest()[:20]}.so"
-
-
 @cache
 def library():
-    """stepping.c compiled (where library_path has none yet) and loaded, kept for the
-    process; None without a working C compiler."""
-    out = library_path()
-    if not out.exists():
-        staged = out.with_name(f".{out.name}.{os.getpid()}")  # whole or not at all: other processes may build it too
-        try:
-            subprocess.run([*_command(), "-o", str(staged), str(SOURCE)], check=True, capture_output=True)
-            os.replace(staged, out)
-        except (OSError, subprocess.CalledProcessError):
-            staged.unlink(missing_ok=True)
-            return None
-    lib = ctypes.CDLL(str(out))
+    """The loop's library loaded, kept for the process; None where the package's build did not make it."""
+    try:
+        lib = ctypes.CDLL(str(built("stepping.so")))
+    except NotBuilt:
+        return None
     lib.stepping_run.restype = ctypes.c_size_t
     lib.stepping_run.argtypes = [ctypes.c_size_t, ctypes.POINTER(SteppedComponent), ctypes.c_double, ctypes.c_double,
                                  ctypes.c_size_t, ctypes.c_size_t, ctypes.c_size_t,

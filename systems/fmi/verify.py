@@ -34,6 +34,7 @@ from attitude_fmu.blocks.filters import accuracy
 from attitude_fmu.blocks.filters.earth_filters import settle_time
 from attitude_fmu.blocks.methods.registry import METHODS
 from attitude_fmu.blocks.methods.registry import method as get_method
+from attitude_fmu.blocks.methods.wiener_local import settled_filter
 from attitude_fmu.systems.cluster.jobs import Failure, Jobs
 from attitude_fmu.systems.fmi.cosim import cosimulate
 from attitude_fmu.systems.fmi.ssp import CHAINS, COMPONENTS, write_ssp
@@ -70,7 +71,7 @@ class Scenario:
         m = get_method(method)
         params = m.resolve()
         if m.runs_kernel(params):  # wiener's local densities: eq. 34 where they settle
-            filt = m.kernel.settled_filter(params, 3.0 * motion.rot_rms**2, motion.delta_v)
+            filt = settled_filter(params, 3.0 * motion.rot_rms**2, motion.delta_v)
         else:
             filt = m.design(params)
         ms = accuracy.mean_square_error(filt, params["delta_n"], motion.delta_v, motion.omega_c, motion.g)

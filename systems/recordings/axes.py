@@ -7,7 +7,7 @@ file's y, y its x and z its −z (the magnetometer of the MPU-9250 sits so to it
 accelerometer). Maps may be reflections: a left-handed sensor becomes right-handed.
 
 The check: gravity and the earth's field are fixed in the earth, so in the frame integrated
-from the gyro (blocks.quaternion.integrate_rates) a sensor's vector stays put, up to the
+from the gyro (attitude_fmu._core.integrate_rates) a sensor's vector stays put, up to the
 motion's acceleration and, for the magnetometer, a hard-iron offset h fixed to the sensor
 (fitted per map). Means over windows of WINDOW_S seconds take most of the acceleration out
 (a window's mean is its change of velocity over WINDOW_S), and the change of the mean from
@@ -25,7 +25,7 @@ import itertools
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from attitude_fmu.blocks.quaternion import integrate_rates
+from attitude_fmu._core import integrate_rates
 from attitude_fmu.systems.recordings.recording import GYR_UNITS
 
 AXES = "xyz"

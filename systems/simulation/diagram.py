@@ -9,12 +9,11 @@ from attitude_fmu.blocks.errors import inclination_error
 from attitude_fmu.blocks.filters.sensor_frame import GRAVITY_OUTPUTS, QUAT_NAMES
 from attitude_fmu.blocks.methods.registry import estimator_system, stepper
 from attitude_fmu.blocks.pipeline.causal import split_params
-from attitude_fmu.blocks.quaternion import quat_rotate
 from attitude_fmu.blocks.stages import gyro_offset as offset_stage
 from attitude_fmu.blocks.stages.heading import heading_system
 from attitude_fmu.blocks.stages.heading import initial_state as heading_initial_state
 from attitude_fmu.blocks.stages.timing import latency_system
-from attitude_fmu.systems.simulation.motion import AXES, EARTH_FIELD_UT, HumanMotion
+from attitude_fmu.systems.simulation.motion import AXES, HumanMotion, earth_field
 from attitude_fmu.systems.simulation.noise import MAGNETOMETER, MOTION, SENSOR, normals
 from attitude_fmu.systems.simulation.sensor_model import ImuModel
 
@@ -38,9 +37,9 @@ def attitude_error_system(fs: float, name: str = "error"):
 def magnetometer_system(imu: ImuModel, fs: float, name: str = "magnetometer"):
     """Static block: the field mag_* (µT, sensor coordinates) the magnetometer of imu
     measures (ImuModel.measure_mag, unit-normal noise nm_*) at the orientation qt_*
-    (EARTH_FIELD_UT in the earth frame, as systems.simulation.motion.Motion.mag)."""
+    (systems.simulation.motion.earth_field, as Motion.mag)."""
     def output(t, x, u, params):
-        return imu.measure_mag(quat_rotate((u[0], -u[1], -u[2], -u[3]), EARTH_FIELD_UT), u[4:7], fs)
+        return imu.measure_mag(earth_field(u[0:4]), u[4:7], fs)
 
     return control.nlsys(None, output, inputs=["qt_w", "qt_x", "qt_y", "qt_z", *MAG_NOISE_INPUTS],
                          outputs=[f"mag_{a}" for a in AXES], dt=1.0 / fs, name=name)

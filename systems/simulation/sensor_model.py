@@ -1,14 +1,20 @@
-"""IMU sensor model: ideal motion signals in, measured signals out (Rizun eqs. 1–2)."""
+"""IMU sensor model: ideal motion signals in, measured signals out (Rizun eqs. 1–2), by the
+simulation's C core (systems/simulation/core: sensor.c, delay_line.c)."""
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import control
 import numpy as np
 
+from attitude_fmu import _core
 from attitude_fmu.systems.simulation.motion import AXES, Motion
 from attitude_fmu.systems.simulation.noise import MAGNETOMETER, SENSOR, normals
+
+
+def _rows(a, width: int) -> np.ndarray:
+    """a (…×width) as a C-contiguous float array of rows."""
+    return np.ascontiguousarray(a, dtype=float).reshape(-1, width)
 
 
 @dataclass(frozen=True)
@@ -36,59 +42,55 @@ class ImuModel:
     latency: float = 0.0
     mag_noise: float = 0.0
     mag_offset: tuple = (0.0, 0.0, 0.0)
+    vector: np.ndarray = field(init=False, repr=False, compare=False)  # the fields as the C core takes them
 
     def __post_init__(self):
-        for name in ("delta_n", "acc_noise", "latency", "mag_noise"):
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value >= 0):
-                raise ValueError(f"{name} must be finite and non-negative, got {value!r}")
-        for name in ("gyr_offset", "acc_offset", "mag_offset"):
-            v = np.asarray(getattr(self, name), dtype=float)
-            if v.shape != (3,) or not np.isfinite(v).all():
-                raise ValueError(f"{name} must be 3 finite numbers, got {getattr(self, name)!r}")
-        S = np.asarray(self.gyr_scale, dtype=float)
-        if S.shape != (3, 3) or not np.isfinite(S).all():
-            raise ValueError(f"gyr_scale must be 3×3 finite numbers, got {self.gyr_scale!r}")
+        parts = []  # the C core checks the values (and words the refusal of a vector's shape)
+        for name, shape in (("delta_n", ()), ("gyr_offset", (3,)), ("gyr_scale", (3, 3)), ("acc_noise", ()),
+                            ("acc_offset", (3,)), ("latency", ()), ("mag_noise", ()), ("mag_offset", (3,))):
+            value = np.asarray(getattr(self, name) if shape else float(getattr(self, name)), dtype=float)
+            if value.shape != shape:
+                _core.imu_refuse_vector(name, getattr(self, name))
+            parts.append(value.ravel())
+        vector = np.concatenate(parts)
+        _core.imu_check(vector)
+        object.__setattr__(self, "vector", vector)
 
     def measure(self, omega, f, noise, fs: float):
         """Measured (gyr, acc) from ideal rate omega, specific force f (…×3) and unit-normal
         noise (…×6: gyro, then accelerometer) at sample rate fs (Hz)."""
-        noise = np.asarray(noise)
-        scale = math.sqrt(fs / 2.0)
-        omega = np.asarray(omega)
-        gyr = (omega + omega @ np.asarray(self.gyr_scale).T + self.delta_n * scale * noise[..., 0:3]
-               + np.asarray(self.gyr_offset))
-        acc = np.asarray(f) + self.acc_noise * scale * noise[..., 3:6] + np.asarray(self.acc_offset)
-        return gyr, acc
+        omega = np.asarray(omega, dtype=float)
+        gyr, acc = np.empty((omega.size // 3, 3)), np.empty((omega.size // 3, 3))
+        _core.imu_measure(self.vector, fs, _rows(omega, 3), _rows(f, 3), _rows(noise, 6), gyr, acc)
+        return gyr.reshape(omega.shape), acc.reshape(omega.shape)
 
     def measure_mag(self, m, noise, fs: float) -> np.ndarray:
         """Measured field (…×3, µT) from the true field m (…×3, µT, sensor coordinates) and
         unit-normal noise (…×3) at sample rate fs (Hz)."""
-        return (np.asarray(m) + self.mag_noise * math.sqrt(fs / 2.0) * np.asarray(noise)
-                + np.asarray(self.mag_offset))
+        m = np.asarray(m, dtype=float)
+        mag = np.empty((m.size // 3, 3))
+        _core.imu_measure_mag(self.vector, fs, _rows(m, 3), _rows(noise, 3), mag)
+        return mag.reshape(m.shape)
 
     def delay_state(self, fs: float, first) -> np.ndarray:
         """The delay line's state at sample rate fs (Hz) before the first sample: the past
-        (ω, f) rows (6 each, flat), all equal to first (the motion before it began)."""
-        return np.tile(np.asarray(first, dtype=float), int(math.floor(self.latency * fs)) + 1)
+        (ω, f) rows (6 each, flat, newest first), all equal to first (the motion before it began)."""
+        return _core.delay_state(self.latency, fs, np.asarray(first, dtype=float))
 
     def delay_step(self, state, signals, fs: float) -> tuple[np.ndarray, np.ndarray]:
         """(next state, signals latency seconds ago) for this sample's true (ω, f) (6).
         Both are means over the sample time (systems.simulation.motion), constant within each: the
         mean over an interval latency = (m + φ)/fs earlier is (1 − φ)·x[k − m] + φ·x[k − m − 1]."""
-        m, phase = divmod(self.latency * fs, 1.0)
-        rows = np.concatenate([np.asarray(signals, dtype=float), state]).reshape(-1, 6)  # x[k], x[k−1], …
-        return rows[:-1].ravel(), (1.0 - phase) * rows[int(m)] + phase * rows[int(m) + 1]
+        return _core.delay_step(self.latency, fs, np.asarray(state, dtype=float), np.asarray(signals, dtype=float))
 
     def delayed(self, omega, f, fs: float, before=None) -> tuple[np.ndarray, np.ndarray]:
         """The true rate and specific force (N×3 each) latency seconds ago, through the
         delay line at fs (Hz); before (ω, f; 6): the motion before the first sample (default
         that sample)."""
-        signals = np.hstack([omega, f])
+        signals = np.hstack([omega, f]).astype(float)
         if self.latency:
-            state = self.delay_state(fs, signals[0] if before is None else before)
-            for k, row in enumerate(signals):
-                state, signals[k] = self.delay_step(state, row, fs)
+            before = signals[0] if before is None else np.asarray(before, dtype=float)
+            _core.delay_run(self.latency, fs, before, signals, signals)
         return signals[:, 0:3], signals[:, 3:6]
 
     def apply(self, motion: Motion, seed: int = 1) -> tuple[np.ndarray, np.ndarray]:

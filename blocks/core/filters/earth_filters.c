@@ -1,5 +1,5 @@
-/* earth_filters.c: Python twin blocks/filters/earth_filters.py; the same operations in the
- * same order (Python's x**2 is pow(x, 2.0)), realised as control.ss does (state_space). */
+/* earth_filters.c: the earth-frame filters' designs (see earth_filters.h), realised as
+ * control.ss does (state_space). */
 #include "earth_filters.h"
 
 #include <math.h>
@@ -72,7 +72,7 @@ int delta_phi(double omega_g, double omega_c, double *out, char *message, size_t
 
 int wiener_band_limited(double omega_g, double omega_c, EarthFilter *out, char *message, size_t size)
 {
-    double dphi, damping;
+    double dphi = 0.0, damping;
     if (delta_phi(omega_g, omega_c, &dphi, message, size)) return -1;
     damping = SQRT2 * omega_g * (cos(dphi / 2) + sin(dphi / 2));
     {

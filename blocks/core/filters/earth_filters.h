@@ -1,8 +1,9 @@
 /* earth_filters.h: Rizun's (2008) earth-frame attitude filters as continuous-time SISO state
  * spaces, the realisation python-control gives their transfer functions.
- * Python twin: blocks/filters/earth_filters.py (same names; frequencies in rad/s, noise
- * densities one-sided, docs/conventions.md). Functions that refuse return 0, or -1 with
- * the Python twin's message. */
+ * The FMUs, which carry no Python, design their filters here; the Python package designs the
+ * same with python-control (blocks/filters/earth_filters.py, same names and messages) and hands
+ * down their zero-order holds. Frequencies in rad/s, noise densities one-sided
+ * (docs/conventions.md). Functions that refuse return 0, or -1 with a message. */
 #ifndef AF_EARTH_FILTERS_H
 #define AF_EARTH_FILTERS_H
 

@@ -1,4 +1,4 @@
-/* matrix.c: Python twins scipy.linalg.expm and numpy.linalg.solve (see matrix.h). */
+/* matrix.c: the matrix exponential and a linear solve (see matrix.h). */
 #include "matrix.h"
 
 #include <math.h>

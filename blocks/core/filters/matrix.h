@@ -1,6 +1,6 @@
 /* matrix.h: the two matrix functions the zero-order hold needs, for matrices of at most
- * MATRIX_MAX rows (row-major, n x n). Python twins: scipy.linalg.expm and
- * numpy.linalg.solve, as blocks/filters/sensor_frame.py uses them (through control.c2d). */
+ * MATRIX_MAX rows (row-major, n x n), as scipy.linalg.expm and numpy.linalg.solve compute them
+ * for control.c2d. */
 #ifndef AF_MATRIX_H
 #define AF_MATRIX_H
 

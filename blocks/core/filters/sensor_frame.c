@@ -1,6 +1,6 @@
-/* sensor_frame.c: Python twin blocks/filters/sensor_frame.py; the same operations in the
- * same order. The zero-order hold is control.c2d's: the exponential of the filter's
- * [[A, B], [0, 0]] Ts (filters/matrix.c). */
+/* sensor_frame.c: the sensor-frame transformation (see sensor_frame.h). The core's own
+ * zero-order hold is control.c2d's: the exponential of the filter's [[A, B], [0, 0]] Ts
+ * (filters/matrix.c). */
 #include "sensor_frame.h"
 
 #include <math.h>
@@ -45,37 +45,20 @@ void rest_state(const DiscreteFilter *d, const double acc0[3], double *X)
         for (i = 0; i < 3; i++) X[j * 3 + i] = unit[j] * acc0[i];
 }
 
-Quat turn_rows(const double *X, double *Xr, int n, const double gyr[3], double Ts)
-{
-    Quat dq = rotvec_quat(gyr[0] * Ts, gyr[1] * Ts, gyr[2] * Ts);
-    /* a vector fixed in the earth frame turns by the inverse rotation in sensor coordinates */
-    Quat dq_inv = quat_conjugate(dq);
-    int j;
-    for (j = 0; j < n; j++) {
-        Vec3 v = quat_rotate(dq_inv, (Vec3){X[j * 3], X[j * 3 + 1], X[j * 3 + 2]});
-        Xr[j * 3] = v.x;
-        Xr[j * 3 + 1] = v.y;
-        Xr[j * 3 + 2] = v.z;
-    }
-    return dq;
-}
-
-void filter_rows(double *X, const double *Xr, const double acc[3], int n, const double *Ad, const double *Bd,
-                 const double *C, double D, double g_out[3])
+/* The discrete LTI filter per axis on the rows Xr: X = Ad Xr + Bd acc^T, g_out = C X + D acc (n states). */
+static void filter_rows(Vec3 *X, const Vec3 *Xr, const double acc[3], int n, const double *Ad, const double *Bd,
+                        const double *C, double D, double g_out[3])
 {
     double a0 = acc[0], a1 = acc[1], a2 = acc[2];
     double g0 = D * a0, g1 = D * a1, g2 = D * a2;
-    int j, m;
-    for (j = 0; j < n; j++) {
+    for (int j = 0; j < n; j++) {
         double s0 = Bd[j] * a0, s1 = Bd[j] * a1, s2 = Bd[j] * a2;
-        for (m = 0; m < n; m++) {
-            s0 += Ad[j * n + m] * Xr[m * 3];
-            s1 += Ad[j * n + m] * Xr[m * 3 + 1];
-            s2 += Ad[j * n + m] * Xr[m * 3 + 2];
+        for (int m = 0; m < n; m++) {
+            s0 += Ad[j * n + m] * Xr[m].x;
+            s1 += Ad[j * n + m] * Xr[m].y;
+            s2 += Ad[j * n + m] * Xr[m].z;
         }
-        X[j * 3] = s0;
-        X[j * 3 + 1] = s1;
-        X[j * 3 + 2] = s2;
+        X[j] = (Vec3){s0, s1, s2};
         g0 += C[j] * s0;
         g1 += C[j] * s1;
         g2 += C[j] * s2;
@@ -85,22 +68,15 @@ void filter_rows(double *X, const double *Xr, const double acc[3], int n, const 
     g_out[2] = g2;
 }
 
-void level_onto_gravity(double q[4], Quat dq, const double g[3])
-{
-    double g0 = g[0], g1 = g[1], g2 = g[2];
-    Quat qt = quat_multiply(quat_load(q), dq);
-    double norm = sqrt(g0 * g0 + g1 * g1 + g2 * g2);
-    if (norm > 0.0) qt = quat_multiply(level_quat(quat_rotate(qt, (Vec3){g0, g1, g2}), norm), qt);
-    quat_store(quat_normalized(qt), q);
-}
-
-void sensor_frame_step(double *X, double q[4], const double gyr[3], const double acc[3], int n, const double *Ad,
+void sensor_frame_step(Vec3 *X, Quat *q, const double gyr[3], const double acc[3], int n, const double *Ad,
                        const double *Bd, const double *C, double D, double Ts, double g_out[3])
 {
-    double Xr[MAX_ORDER * 3];
-    Quat dq = turn_rows(X, Xr, n, gyr, Ts);
+    Vec3 Xr[MAX_ORDER];
+    Quat dq = rotvec_quat(gyr[0] * Ts, gyr[1] * Ts, gyr[2] * Ts);
+    /* the rows, earth-fixed, turned into this sample's sensor frame: by the inverse rotation */
+    for (int j = 0; j < n; j++) Xr[j] = quat_rotate(quat_conjugate(dq), X[j]);
     filter_rows(X, Xr, acc, n, Ad, Bd, C, D, g_out);
-    level_onto_gravity(q, dq, g_out);
+    *q = level_onto_gravity(*q, dq, (Vec3){g_out[0], g_out[1], g_out[2]});
 }
 
 void start_gravity(const double gyr0[3], const double acc0[3], double Ts, double out[3])
@@ -115,8 +91,5 @@ void start_gravity(const double gyr0[3], const double acc0[3], double Ts, double
 void sensor_frame_initial_state(const DiscreteFilter *d, const double acc0[3], double *state)
 {
     rest_state(d, acc0, state);
-    state[3 * d->n] = 1.0;
-    state[3 * d->n + 1] = 0.0;
-    state[3 * d->n + 2] = 0.0;
-    state[3 * d->n + 3] = 0.0;
+    quat_store((Quat){1.0, 0.0, 0.0, 0.0}, state + 3 * d->n);
 }

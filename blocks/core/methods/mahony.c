@@ -1,4 +1,4 @@
-/* mahony.c: Python twin blocks/methods/mahony.py; the same operations in the same order. */
+/* mahony.c: Mahony's filter (see mahony.h). */
 #include "mahony.h"
 
 #include <math.h>
@@ -7,7 +7,7 @@
 
 int mahony_check_gains(double k_P, double k_I, double Ts, char *message, size_t size)
 {
-    /* "k_P\302\267Ts": k_P·Ts; "1/s\302\262": 1/s²; "\342\210\222": − (UTF-8, as Python's message) */
+    /* "k_P\302\267Ts": k_P·Ts; "1/s\302\262": 1/s²; "\342\210\222": − (UTF-8) */
     if (k_P * Ts >= 2.0)
         return refuse(message, size,
                       "parameter k_P = %g 1/s is unstable at the sample time %g s: Mahony's step needs "
@@ -22,46 +22,32 @@ int mahony_check_gains(double k_P, double k_I, double Ts, char *message, size_t 
     return 0;
 }
 
-int mahony_coefficients(const double params[AF_N_PARAMS], double Ts, double coef[MAHONY_COEF_SIZE], char *message,
-                        size_t size)
+int mahony_coefficients(const double params[AF_N_PARAMS], double Ts, MahonyCoef *coef, char *message, size_t size)
 {
     if (mahony_check_gains(params[AF_P_k_P], params[AF_P_k_I], Ts, message, size)) return -1;
-    coef[0] = params[AF_P_k_P];
-    coef[1] = params[AF_P_k_I];
-    coef[2] = Ts;
-    coef[3] = params[AF_P_g];
+    *coef = (MahonyCoef){params[AF_P_k_P], params[AF_P_k_I], Ts, params[AF_P_g]};
     return 0;
 }
 
-void mahony_initial_state(const double coef[MAHONY_COEF_SIZE], const double acc0[3], double state[MAHONY_STATE_SIZE])
+void mahony_initial_state(const MahonyCoef *coef, const double acc0[3], MahonyState *state)
 {
     (void)coef;
-    level_on(acc0, state);
-    state[4] = state[5] = state[6] = 0.0;
+    *state = (MahonyState){level_on(acc0), {0.0, 0.0, 0.0}};
 }
 
-void level_on(const double acc0[3], double q[4])
+Quat level_on(const double acc0[3])
 {
     double norm = sqrt(acc0[0] * acc0[0] + acc0[1] * acc0[1] + acc0[2] * acc0[2]);
     double u0 = acc0[0] / norm, u1 = acc0[1] / norm, u2 = acc0[2] / norm;
     double w = 1.0 + u2, qn;
-    if (w < 1e-12) {
-        q[0] = 0.0;
-        q[1] = 1.0;
-        q[2] = q[3] = 0.0;
-        return;
-    }
+    if (w < 1e-12) return (Quat){0.0, 1.0, 0.0, 0.0};
     qn = sqrt(w * w + u1 * u1 + u0 * u0);
-    q[0] = w / qn;
-    q[1] = u1 / qn;
-    q[2] = -u0 / qn;
-    q[3] = 0.0 / qn;
+    return (Quat){w / qn, u1 / qn, -u0 / qn, 0.0 / qn};
 }
 
-Vec3 mahony_step(double state[MAHONY_STATE_SIZE], double k_P, double k_I, double Ts, const double gyr[3],
-                 const double acc[3])
+Vec3 mahony_step(MahonyState *state, double k_P, double k_I, double Ts, const double gyr[3], const double acc[3])
 {
-    Quat q = quat_load(state);
+    Quat q = state->q;
     Vec3 v_hat = up_in_sensor(q);
     double a0 = acc[0], a1 = acc[1], a2 = acc[2];
     double norm = sqrt(a0 * a0 + a1 * a1 + a2 * a2);
@@ -72,20 +58,19 @@ Vec3 mahony_step(double state[MAHONY_STATE_SIZE], double k_P, double k_I, double
         e1 = v2 * v_hat.x - v0 * v_hat.z;
         e2 = v0 * v_hat.y - v1 * v_hat.x;
     }
-    state[4] -= k_I * e0 * Ts;
-    state[5] -= k_I * e1 * Ts;
-    state[6] -= k_I * e2 * Ts;
-    w0 = gyr[0] - state[4] + k_P * e0;
-    w1 = gyr[1] - state[5] + k_P * e1;
-    w2 = gyr[2] - state[6] + k_P * e2;
-    q = quat_normalized(quat_multiply(q, rotvec_quat(w0 * Ts, w1 * Ts, w2 * Ts)));
-    quat_store(q, state);
-    return up_in_sensor(q);
+    state->b.x -= k_I * e0 * Ts;
+    state->b.y -= k_I * e1 * Ts;
+    state->b.z -= k_I * e2 * Ts;
+    w0 = gyr[0] - state->b.x + k_P * e0;
+    w1 = gyr[1] - state->b.y + k_P * e1;
+    w2 = gyr[2] - state->b.z + k_P * e2;
+    state->q = quat_normalized(quat_multiply(q, rotvec_quat(w0 * Ts, w1 * Ts, w2 * Ts)));
+    return up_in_sensor(state->q);
 }
 
-void mahony_run(double state[MAHONY_STATE_SIZE], const double coef[MAHONY_COEF_SIZE], const double gyr[3],
-                const double acc[3], double gravity[3], double quat[4])
+void mahony_run(MahonyState *state, const MahonyCoef *coef, const double gyr[3], const double acc[3],
+                double gravity[3], double quat[4])
 {
-    Vec3 up = mahony_step(state, coef[0], coef[1], coef[2], gyr, acc);
-    write_sample(gravity, quat, coef[3], up, state);
+    Vec3 up = mahony_step(state, coef->k_P, coef->k_I, coef->Ts, gyr, acc);
+    write_sample(gravity, quat, coef->g, up, state->q);
 }

@@ -1,5 +1,4 @@
-/* registry.c: Python twin blocks/methods/registry.py (METHODS, method, Method.resolve,
- * runs_kernel, Method.filter, stepper, KernelStepper and SensorFrameStepper). */
+/* registry.c: the methods by name (see registry.h). */
 #include "registry.h"
 
 #include <math.h>
@@ -8,18 +7,11 @@
 
 #include "filters/tseng.h"
 #include "messages.h"
-#include "methods/luinge.h"
-#include "methods/mahony.h"
-#include "methods/tseng_adaptive.h"
-#include "methods/wiener_local.h"
-#include "params.h"
 
-typedef char state_fits[AF_STEPPER_STATE_MAX >= TSENG_ADAPTIVE_STATE_SIZE &&
-                                AF_STEPPER_STATE_MAX >= WIENER_LOCAL_STATE_SIZE &&
-                                AF_STEPPER_STATE_MAX >= SENSOR_FRAME_STATE_SIZE(MAX_ORDER)
-                            ? 1
-                            : -1];
-typedef char coef_fits[AF_STEPPER_COEF_MAX >= TSENG_ADAPTIVE_COEF_SIZE ? 1 : -1];
+const char *const KERNEL_NAMES[KERNEL_COUNT] = {
+    [KERNEL_NONE] = "sensor_frame", [KERNEL_WIENER_LOCAL] = "wiener_local", [KERNEL_TSENG_ADAPTIVE] = "tseng_adaptive",
+    [KERNEL_LUINGE] = "luinge", [KERNEL_MAHONY] = "mahony",
+};
 
 int method_index(const char *name, char *message, size_t size)
 {
@@ -46,13 +38,14 @@ static int stationary_omega_g(const double *p, double *out, char *message, size_
                    message, size);
 }
 
-/* _wiener_is_local: whether `wiener` runs its local kernel (resolve_params took a stationary of 0 or 1 only) */
+/* whether `wiener` runs its local kernel (resolve_given took a stationary of 0 or 1 only) */
 static int wiener_is_local(const double *p)
 {
     return p[AF_P_stationary] == 0.0 && isnan(p[AF_P_omega_g]) && isnan(p[AF_P_omega_c]) && isnan(p[AF_P_delta_v]);
 }
 
-/* the design of each sensor-frame method: _design_wiener, _design_first_order, tseng's */
+/* the design of each earth filter a method runs: wiener's stationary filter, first_order's, tseng's (also
+ * tseng_adaptive's complementary mode) */
 static int design(int method, const double *p, EarthFilter *f, char *message, size_t size)
 {
     double wg, wf;
@@ -67,7 +60,7 @@ static int design(int method, const double *p, EarthFilter *f, char *message, si
             best_first_order_cutoff(wg, p[AF_P_omega_c], &wf, message, size))
             return -1;
         return first_order(wf, f, message, size);
-    default: /* AF_STAGE_tseng */
+    default: /* AF_STAGE_tseng, AF_STAGE_tseng_adaptive */
         tseng_earth_filter(f);
         return 0;
     }
@@ -97,12 +90,12 @@ static int finite_values(const double *values, int n)
     return 1;
 }
 
-int method_configure(AfMethod *m, int index, const double given[AF_N_PARAMS], char *message, size_t size)
+int method_configure(AfMethod *m, int index, const AfGiven *given, int n, char *message, size_t size)
 {
     char text[512];
     memset(m, 0, sizeof *m);
     m->method = index;
-    if (resolve_params(index, given, m->params, message, size)) return -1;
+    if (resolve_given(index, given, n, m->params, message, size)) return -1;
     switch (index) {
     case AF_STAGE_wiener:
         m->kernel = wiener_is_local(m->params) ? KERNEL_WIENER_LOCAL : KERNEL_NONE;
@@ -112,7 +105,7 @@ int method_configure(AfMethod *m, int index, const double given[AF_N_PARAMS], ch
     case AF_STAGE_mahony: m->kernel = KERNEL_MAHONY; break;
     default: m->kernel = KERNEL_NONE;
     }
-    if (m->kernel != KERNEL_NONE) return 0;
+    if (m->kernel != KERNEL_NONE && m->kernel != KERNEL_TSENG_ADAPTIVE) return 0;
     if (design(index, m->params, &m->filter, message, size)) return -1;
     if (!(finite_values(m->filter.A, m->filter.n * m->filter.n) && finite_values(m->filter.B, m->filter.n) &&
           finite_values(m->filter.C, m->filter.n) && isfinite(m->filter.D))) {
@@ -123,22 +116,33 @@ int method_configure(AfMethod *m, int index, const double given[AF_N_PARAMS], ch
     return 0;
 }
 
-/* the kernels (KernelStepper): their state and coefficient sizes, initial_state and run */
-static const struct {
-    int state_size, coef_size;
-    void (*initial_state)(const double *coef, const double *gravity, double *state);
-    void (*run)(double *state, const double *coef, const double *gyr, const double *acc, double *gravity,
-                double *quat);
-} KERNELS[] = {
-    [KERNEL_WIENER_LOCAL] = {WIENER_LOCAL_STATE_SIZE, WIENER_LOCAL_COEF_SIZE, wiener_local_initial_state,
-                             wiener_local_run},
-    [KERNEL_TSENG_ADAPTIVE] = {TSENG_ADAPTIVE_STATE_SIZE, TSENG_ADAPTIVE_COEF_SIZE, tseng_adaptive_initial_state,
-                               tseng_adaptive_run},
-    [KERNEL_LUINGE] = {LUINGE_STATE_SIZE, LUINGE_COEF_SIZE, luinge_initial_state, luinge_run},
-    [KERNEL_MAHONY] = {MAHONY_STATE_SIZE, MAHONY_COEF_SIZE, mahony_initial_state, mahony_run},
+/* the kernels' state names after the filter rows some have (tseng_adaptive's), in order */
+static const char *const KERNEL_STATE_NAMES[KERNEL_COUNT][WIENER_LOCAL_STATE_SIZE + 1] = {
+    [KERNEL_NONE] = {"q_w", "q_x", "q_y", "q_z", NULL},
+    [KERNEL_WIENER_LOCAL] = {"g_x", "g_y", "g_z", "u_x", "u_y", "u_z", "v_x", "v_y", "v_z", "f_x", "f_y", "f_z",
+                             "q_w", "q_x", "q_y", "q_z", "w2", "v2", "omega_g", "t", NULL},
+    [KERNEL_TSENG_ADAPTIVE] = {"q_w", "q_x", "q_y", "q_z", "b_x", "b_y", "b_z", NULL},
+    [KERNEL_LUINGE] = {"q_w", "q_x", "q_y", "q_z", "P_x", "P_y", NULL},
+    [KERNEL_MAHONY] = {"q_w", "q_x", "q_y", "q_z", "b_x", "b_y", "b_z", NULL},
 };
 
-int stepper_at(AfStepper *s, const AfMethod *m, double Ts, char *message, size_t size)
+/* the method's earth filter held over Ts: by zoh, or the core's own; its order checked */
+static int hold(const AfMethod *m, double Ts, const AfZoh *zoh, DiscreteFilter *disc, char *message, size_t size)
+{
+    if (zoh == NULL) return discrete_filter(&m->filter, Ts, disc, message, size);
+    memset(disc, 0, sizeof *disc);
+    if (zoh->hold(zoh->context, Ts, disc, message, size)) return -1;
+    if (disc->n < 0 || disc->n > MAX_ORDER)
+        return refuse(message, size, "%s: its earth-frame filter has %d states, at most %d are taken",
+                      AF_STAGES[m->method].owner, disc->n, MAX_ORDER);
+    disc->Ts = Ts;
+    return 0;
+}
+
+/* whether every double of a coefficient struct is finite */
+#define FINITE_STRUCT(c) finite_values((const double *)&(c), (int)(sizeof(c) / sizeof(double)))
+
+int stepper_at(AfStepper *s, const AfMethod *m, double Ts, const AfZoh *zoh, char *message, size_t size)
 {
     char text[512], value[FLOAT_REPR_SIZE];
     int finite;
@@ -148,22 +152,42 @@ int stepper_at(AfStepper *s, const AfMethod *m, double Ts, char *message, size_t
     if (!(isfinite(Ts) && Ts > 0))
         return refuse(message, size, "sample time Ts must be a finite positive number of seconds, got %s",
                       float_repr(Ts, value));
-    if (m->kernel == KERNEL_NONE) {
-        if (discrete_filter(&m->filter, Ts, &s->disc, message, size)) return -1;
-        s->state_size = SENSOR_FRAME_STATE_SIZE(s->disc.n);
-        finite = finite_values(s->disc.Ad, s->disc.n * s->disc.n) && finite_values(s->disc.Bd, s->disc.n);
-    } else {
-        if (m->kernel == KERNEL_TSENG_ADAPTIVE) {
-            if (tseng_adaptive_coefficients(m->params, Ts, s->coef, message, size)) return -1;
-        } else if (m->kernel == KERNEL_WIENER_LOCAL) {
-            wiener_local_coefficients(m->params, Ts, s->coef);
-        } else if (m->kernel == KERNEL_LUINGE) {
-            luinge_coefficients(m->params, Ts, s->coef);
-        } else if (mahony_coefficients(m->params, Ts, s->coef, message, size)) {
+    switch (m->kernel) {
+    case KERNEL_NONE: {
+        DiscreteFilter *d = &s->coef.sensor_frame;
+        if (hold(m, Ts, zoh, d, message, size)) return -1;
+        s->state_size = SENSOR_FRAME_STATE_SIZE(d->n);
+        finite = finite_values(d->Ad, d->n * d->n) && finite_values(d->Bd, d->n);
+        break;
+    }
+    case KERNEL_TSENG_ADAPTIVE: {
+        /* its Mahony mode's gains first, then its complementary filter */
+        DiscreteFilter d;
+        if (mahony_check_gains(m->params[AF_P_k_P], m->params[AF_P_k_I], Ts, message, size) ||
+            hold(m, Ts, zoh, &d, message, size))
             return -1;
-        }
-        s->state_size = KERNELS[m->kernel].state_size;
-        finite = finite_values(s->coef, KERNELS[m->kernel].coef_size);
+        if (d.n != TSENG_ORDER)
+            return refuse(message, size, "%s: its earth-frame filter has %d states, not %d", AF_STAGES[m->method].owner,
+                          d.n, TSENG_ORDER);
+        tseng_adaptive_coefficients(m->params, &d, &s->coef.tseng_adaptive);
+        s->state_size = sizeof(TsengAdaptiveState) / sizeof(double);
+        finite = finite_values(d.Ad, d.n * d.n) && finite_values(d.Bd, d.n) && finite_values(d.C, d.n);
+        break;
+    }
+    case KERNEL_WIENER_LOCAL:
+        wiener_local_coefficients(m->params, Ts, &s->coef.wiener_local);
+        s->state_size = WIENER_LOCAL_STATE_SIZE;
+        finite = FINITE_STRUCT(s->coef.wiener_local);
+        break;
+    case KERNEL_LUINGE:
+        luinge_coefficients(m->params, Ts, &s->coef.luinge);
+        s->state_size = sizeof(LuingeState) / sizeof(double);
+        finite = FINITE_STRUCT(s->coef.luinge);
+        break;
+    default: /* KERNEL_MAHONY */
+        if (mahony_coefficients(m->params, Ts, &s->coef.mahony, message, size)) return -1;
+        s->state_size = sizeof(MahonyState) / sizeof(double);
+        finite = FINITE_STRUCT(s->coef.mahony);
     }
     if (finite) return 0;
     params_text(m, text, sizeof text);
@@ -171,22 +195,82 @@ int stepper_at(AfStepper *s, const AfMethod *m, double Ts, char *message, size_t
                   text);
 }
 
+int stepper_of_filter(AfStepper *s, const DiscreteFilter *d, char *message, size_t size)
+{
+    char value[FLOAT_REPR_SIZE];
+    memset(s, 0, sizeof *s);
+    if (!(isfinite(d->Ts) && d->Ts > 0))
+        return refuse(message, size, "sample time Ts must be a finite positive number of seconds, got %s",
+                      float_repr(d->Ts, value));
+    if (d->n < 0 || d->n > MAX_ORDER)
+        return refuse(message, size, "the earth-frame filter has %d states, at most %d are taken", d->n, MAX_ORDER);
+    s->kernel = KERNEL_NONE;
+    s->Ts = d->Ts;
+    s->coef.sensor_frame = *d;
+    s->state_size = SENSOR_FRAME_STATE_SIZE(d->n);
+    return 0;
+}
+
+void stepper_state_names(const AfStepper *s, char names[][STATE_NAME_SIZE])
+{
+    static const char axes[3] = {'x', 'y', 'z'};
+    int rows = s->kernel == KERNEL_NONE ? s->coef.sensor_frame.n : s->kernel == KERNEL_TSENG_ADAPTIVE ? TSENG_ORDER : 0;
+    int k = 0;
+    for (int j = 0; j < rows; j++) /* x<j>_<axis>, j below MAX_ORDER: one digit */
+        for (int i = 0; i < 3; i++) {
+            char *name = names[k++];
+            name[0] = 'x', name[1] = (char)('0' + j), name[2] = '_', name[3] = axes[i], name[4] = '\0';
+        }
+    for (const char *const *name = KERNEL_STATE_NAMES[s->kernel]; *name != NULL; name++)
+        snprintf(names[k++], STATE_NAME_SIZE, "%s", *name);
+}
+
+/* The stepper's state array as the kernel's state struct (the array is of doubles, as the struct's members) */
+#define STATE(type, state) ((type *)(void *)(state))
+
 void stepper_initial_state(const AfStepper *s, const double gravity[3], double *state)
 {
-    if (s->kernel == KERNEL_NONE)
-        sensor_frame_initial_state(&s->disc, gravity, state);
-    else
-        KERNELS[s->kernel].initial_state(s->coef, gravity, state);
+    switch (s->kernel) {
+    case KERNEL_WIENER_LOCAL:
+        wiener_local_initial_state(&s->coef.wiener_local, gravity, STATE(WienerLocalState, state));
+        break;
+    case KERNEL_TSENG_ADAPTIVE:
+        tseng_adaptive_initial_state(&s->coef.tseng_adaptive, gravity, STATE(TsengAdaptiveState, state));
+        break;
+    case KERNEL_LUINGE: luinge_initial_state(&s->coef.luinge, gravity, STATE(LuingeState, state)); break;
+    case KERNEL_MAHONY: mahony_initial_state(&s->coef.mahony, gravity, STATE(MahonyState, state)); break;
+    default: sensor_frame_initial_state(&s->coef.sensor_frame, gravity, state);
+    }
 }
 
 void stepper_run(const AfStepper *s, double *state, const double gyr[3], const double acc[3], double gravity[3],
                  double quat[4])
 {
-    const DiscreteFilter *d = &s->disc;
-    if (s->kernel != KERNEL_NONE) {
-        KERNELS[s->kernel].run(state, s->coef, gyr, acc, gravity, quat);
+    const DiscreteFilter *d = &s->coef.sensor_frame;
+    switch (s->kernel) {
+    case KERNEL_WIENER_LOCAL:
+        wiener_local_run(STATE(WienerLocalState, state), &s->coef.wiener_local, gyr, acc, gravity, quat);
+        break;
+    case KERNEL_TSENG_ADAPTIVE:
+        tseng_adaptive_run(STATE(TsengAdaptiveState, state), &s->coef.tseng_adaptive, gyr, acc, gravity, quat);
+        break;
+    case KERNEL_LUINGE: luinge_run(STATE(LuingeState, state), &s->coef.luinge, gyr, acc, gravity, quat); break;
+    case KERNEL_MAHONY: mahony_run(STATE(MahonyState, state), &s->coef.mahony, gyr, acc, gravity, quat); break;
+    default:
+        sensor_frame_step(STATE(Vec3, state), STATE(Quat, state + 3 * d->n), gyr, acc, d->n, d->Ad, d->Bd, d->C,
+                          d->D, d->Ts, gravity);
+        quat_store(*STATE(Quat, state + 3 * d->n), quat);
+    }
+}
+
+void stepper_run_rows(const AfStepper *s, double *state, size_t n, const double *gyr, const double *acc,
+                      double *gravity, double *quat)
+{
+    if (s->kernel == KERNEL_WIENER_LOCAL) {
+        wiener_local_rows(STATE(WienerLocalState, state), &s->coef.wiener_local, n, gyr, acc, NULL, gravity, quat,
+                          NULL);
         return;
     }
-    sensor_frame_step(state, state + 3 * d->n, gyr, acc, d->n, d->Ad, d->Bd, d->C, d->D, d->Ts, gravity);
-    quat_store(quat_load(state + 3 * d->n), quat);
+    for (size_t k = 0; k < n; k++)
+        stepper_run(s, state, gyr + 3 * k, acc + 3 * k, gravity + 3 * k, quat + 4 * k);
 }

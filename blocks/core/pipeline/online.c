@@ -1,4 +1,4 @@
-/* online.c: Python twin blocks/pipeline/online.py (OnlineEstimator). */
+/* online.c: the causal pipeline one sample at a time (see online.h). */
 #include "pipeline/online.h"
 
 #include <math.h>
@@ -9,13 +9,22 @@
 
 int af_online_init(AfOnline *est, const AfConfig *config, char *message, size_t size)
 {
+    AfPipeline pipeline;
+    AfGiven given[AF_N_PARAMS];
     memset(est, 0, sizeof *est);
-    if (causal_configure(&est->pipeline, config->method, config->params, config->gyro_offset, config->heading,
-                         config->latency, config->gyr_samples ? config->gyr_samples : "mean",
+    if (causal_configure(&pipeline, config->method, given, given_values(config->params, given), config->gyro_offset,
+                         config->heading, config->latency, config->gyr_samples ? config->gyr_samples : "mean",
                          config->acc_samples ? config->acc_samples : "point", message, size))
         return -1;
-    af_online_reset(est);
+    af_online_of(est, &pipeline);
     return 0;
+}
+
+void af_online_of(AfOnline *est, const AfPipeline *pipeline)
+{
+    memset(est, 0, sizeof *est);
+    est->pipeline = *pipeline;
+    af_online_reset(est);
 }
 
 void af_online_reset(AfOnline *est)
@@ -28,14 +37,14 @@ void af_online_reset(AfOnline *est)
     est->quat[0] = 1.0;
     est->up[2] = 1.0;
     for (int i = 0; i < 3; i++)
-        est->mag_offset[i] = est->state.heading[HARD_IRON_OFFSET + i];
-    est->mag_delay = est->state.heading[MAG_DELAY_IN_USE];
+        est->mag_offset[i] = est->state.heading.hard_iron.offset[i];
+    est->mag_delay = est->state.heading.mag_delay.delay;
 }
 
-int af_online_discretise(AfOnline *est, double Ts, char *message, size_t size)
+int af_online_discretise(AfOnline *est, double Ts, const AfZoh *zoh, char *message, size_t size)
 {
     AfStep step;
-    if (causal_at(&est->pipeline, Ts, &step, message, size))
+    if (causal_at(&est->pipeline, Ts, zoh, &step, message, size))
         return -1;
     est->step = step;
     est->discretised = 1;
@@ -45,7 +54,13 @@ int af_online_discretise(AfOnline *est, double Ts, char *message, size_t size)
 int af_online_step(AfOnline *est, const double gyr[3], const double acc[3], const double mag[3], double Ts,
                    char *message, size_t size)
 {
-    if (!(est->discretised && same_step(Ts, est->step.Ts)) && af_online_discretise(est, Ts, message, size))
+    return af_online_step_with(est, gyr, acc, mag, Ts, NULL, message, size);
+}
+
+int af_online_step_with(AfOnline *est, const double gyr[3], const double acc[3], const double mag[3], double Ts,
+                        const AfZoh *zoh, char *message, size_t size)
+{
+    if (!(est->discretised && same_step(Ts, est->step.Ts)) && af_online_discretise(est, Ts, zoh, message, size))
         return -1;
     int any_acc = acc[0] != 0.0 || acc[1] != 0.0 || acc[2] != 0.0;
     if (!(valid_sample(gyr, acc) && (est->state.started || any_acc))) {
@@ -63,9 +78,9 @@ int af_online_step(AfOnline *est, const double gyr[3], const double acc[3], cons
     for (int i = 0; i < 3; i++) {
         est->up[i] = g[i] / norm;
         est->offset[i] = est->pipeline.offset_runs ? row.offset[i] : 0.0;
-        est->mag_offset[i] = est->state.heading[HARD_IRON_OFFSET + i];
+        est->mag_offset[i] = est->state.heading.hard_iron.offset[i];
     }
-    est->mag_delay = est->state.heading[MAG_DELAY_IN_USE];
+    est->mag_delay = est->state.heading.mag_delay.delay;
     Vec3 euler = quat_euler_zyx(quat_load(est->quat));
     est->euler[0] = euler.x, est->euler[1] = euler.y, est->euler[2] = euler.z;
     return 1;

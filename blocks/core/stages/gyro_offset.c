@@ -1,63 +1,67 @@
-/* gyro_offset.c: Python twin blocks/stages/gyro_offset.py; the same operations in the same order. */
+/* gyro_offset.c: the gyroscope-offset estimator (documented in blocks/stages/gyro_offset.py). */
 #include "stages/gyro_offset.h"
 
 #include <math.h>
+#include <string.h>
 
 #include "methods/wiener_local.h"
 #include "quaternion.h"
 
-/* the state's layout (STATE_NAMES): low-passed gyro 0..2, accelerometer 3..5, time at rest 6, offset b 7..9 */
-#define T 10       /* time since the start (s) */
-#define QUAT 11    /* sensor -> gyro frame, 4 entries */
-#define ACC_LP 15  /* Butterworth rows of the accelerometer in the gyro frame, 2 x 3 */
-#define R_LP 21    /* Butterworth rows of R, 2 x 9 */
-#define RB_LP 39   /* Butterworth rows of R.b, 2 x 3 */
-#define COV 45     /* covariance of the offset estimate, 3 x 3 */
-#define SHORT 54   /* gyro and accelerometer through the short low-pass, 6 entries */
 #define OBSERVED 0.5    /* the least share of an offset's effect H must keep in a direction to update it */
 #define CLIP_SIGMAS 4.0 /* innovations clipped at this many sigma_init */
 #define SETTLE_TAUS 3.0 /* no update before this many tau_acc (the low-pass forgetting its start) */
 
-void gyro_offset_coefficients(const double params[AF_N_PARAMS], double Ts, double coef[GYRO_OFFSET_COEF_SIZE])
+#define STATE_FIELD(name, dims) AF_FIELD(AfGyroOffset, name)
+const AfField GYRO_OFFSET_STATE_FIELDS[] = {GYRO_OFFSET_FIELDS(STATE_FIELD)};
+const size_t GYRO_OFFSET_N_FIELDS = sizeof GYRO_OFFSET_STATE_FIELDS / sizeof GYRO_OFFSET_STATE_FIELDS[0];
+
+int gyro_offset_coefficients(const double params[AF_N_PARAMS], double Ts, AfGyroOffsetCoef *coef)
 {
     double tau_motion = params[AF_P_tau_motion], s2 = params[AF_P_sigma_motion] * params[AF_P_sigma_motion];
     double V = tau_motion > 0 ? s2 * Ts / tau_motion : 0.0;
     double delta_n = params[AF_P_delta_n];
     double noise_floor = REST_NOISE_SIGMAS * delta_n / sqrt(4 * params[AF_P_tau_short]);
-    coef[0] = Ts;
-    coef[1] = 1.0 - exp(-Ts / params[AF_P_tau_lp]);
-    coef[2] = delta_n * delta_n / (2.0 * Ts);
-    coef[3] = noise_floor > params[AF_P_rest_gyr] ? noise_floor : params[AF_P_rest_gyr];
-    coef[4] = params[AF_P_rest_gyr_abs];
-    coef[5] = params[AF_P_rest_acc];
-    coef[6] = params[AF_P_rest_time];
-    coef[7] = sqrt(2.0) / params[AF_P_tau_acc] * Ts;
-    coef[8] = params[AF_P_sigma_init] * params[AF_P_sigma_init];
-    coef[9] = V;
-    coef[10] = V > 0 ? s2 * s2 / V + s2 : 0.0;
-    coef[11] = 1.0 - exp(-Ts / params[AF_P_tau_short]);
+    double wt = sqrt(2.0) / params[AF_P_tau_acc] * Ts;
+    coef->Ts = Ts;
+    coef->a_lp = 1.0 - exp(-Ts / params[AF_P_tau_lp]);
+    coef->a_short = 1.0 - exp(-Ts / params[AF_P_tau_short]);
+    coef->r = delta_n * delta_n / (2.0 * Ts);
+    coef->rest_gyr = noise_floor > params[AF_P_rest_gyr] ? noise_floor : params[AF_P_rest_gyr];
+    coef->rest_gyr_abs = params[AF_P_rest_gyr_abs];
+    coef->rest_acc = params[AF_P_rest_acc];
+    coef->rest_time = params[AF_P_rest_time];
+    coef->P0 = params[AF_P_sigma_init] * params[AF_P_sigma_init];
+    coef->V = V;
+    coef->W = V > 0 ? s2 * s2 / V + s2 : 0.0;
+    butterworth_zoh(wt, coef->Ad, coef->Bd);
+    coef->tau_acc = sqrt(2.0) * Ts / wt;
+    coef->settle = SETTLE_TAUS * coef->tau_acc;
+    coef->clip = CLIP_SIGMAS * sqrt(coef->P0);
+    return af_finite(coef, sizeof *coef, NULL) ? 0 : -1;
 }
 
-void gyro_offset_initial_state(const double coef[GYRO_OFFSET_COEF_SIZE], const double gyr0[3], const double acc0[3],
-                               double state[GYRO_OFFSET_STATE_SIZE])
+void gyro_offset_initial_state(const AfGyroOffsetCoef *coef, const double gyr0[3], const double acc0[3],
+                               AfGyroOffset *state)
 {
-    for (int i = 0; i < GYRO_OFFSET_STATE_SIZE; i++)
-        state[i] = 0.0;
+    memset(state, 0, sizeof *state);
     for (int i = 0; i < 3; i++) {
-        state[i] = state[SHORT + i] = gyr0[i];
-        state[3 + i] = state[SHORT + 3 + i] = acc0[i];
-        state[R_LP + 4 * i] = 1.0;   /* LP(R) settled on I */
-        state[COV + 4 * i] = coef[8]; /* P0 on the diagonal */
+        state->lp_gyr[i] = state->short_gyr[i] = gyr0[i];
+        state->lp_acc[i] = state->short_acc[i] = acc0[i];
+        state->r_lp[0][4 * i] = 1.0; /* LP(R) settled on I */
+        state->P[4 * i] = coef->P0;   /* P0 on the diagonal */
     }
-    state[QUAT] = 1.0;
+    state->q[0] = 1.0;
 }
 
-/* lowpass_step: column j of the Butterworth's two state rows (rows, each of width columns) after the input x */
-static void lowpass_step(double *rows, int width, int j, double x, const double Ad[4], const double Bd[2])
+/* lowpass_rows: the Butterworth's two state rows (value, rate; width columns each) after the inputs x */
+static inline void lowpass_rows(double *restrict value, double *restrict rate, int width, const double *restrict x,
+                                const double Ad[4], const double Bd[2])
 {
-    double x0 = rows[j], x1 = rows[width + j];
-    rows[j] = Ad[0] * x0 + Ad[1] * x1 + Bd[0] * x;
-    rows[width + j] = Ad[2] * x0 + Ad[3] * x1 + Bd[1] * x;
+    for (int j = 0; j < width; j++) {
+        double x0 = value[j], x1 = rate[j];
+        value[j] = Ad[0] * x0 + Ad[1] * x1 + Bd[0] * x[j];
+        rate[j] = Ad[2] * x0 + Ad[3] * x1 + Bd[1] * x[j];
+    }
 }
 
 static double dot(const double u[3], const double v[3])
@@ -102,40 +106,44 @@ static void scalar_update(double b[3], double P[9], const double h[3], double z,
     }
 }
 
-/* plane_basis: two orthonormal vectors e1, e2 across the unit vector n */
-static void plane_basis(const double n[3], double e1[3], double e2[3])
+/* across: a vector across v (not normalised): the axis least along v, crossed with v */
+static void across(const double v[3], double e[3])
 {
-    double e[3];
-    /* the axis least along n, crossed with n */
-    if (fabs(n[0]) <= fabs(n[1]) && fabs(n[0]) <= fabs(n[2])) {
-        e[0] = 0.0, e[1] = n[2], e[2] = -n[1];
-    } else if (fabs(n[1]) <= fabs(n[2])) {
-        e[0] = -n[2], e[1] = 0.0, e[2] = n[0];
+    if (fabs(v[0]) <= fabs(v[1]) && fabs(v[0]) <= fabs(v[2])) {
+        e[0] = 0.0, e[1] = v[2], e[2] = -v[1];
+    } else if (fabs(v[1]) <= fabs(v[2])) {
+        e[0] = -v[2], e[1] = 0.0, e[2] = v[0];
     } else {
-        e[0] = n[1], e[1] = -n[0], e[2] = 0.0;
+        e[0] = v[1], e[1] = -v[0], e[2] = 0.0;
     }
-    double norm = sqrt(dot(e, e));
-    for (int i = 0; i < 3; i++)
-        e1[i] = e[i] / norm;
-    e2[0] = n[1] * e1[2] - n[2] * e1[1];
-    e2[1] = n[2] * e1[0] - n[0] * e1[2];
-    e2[2] = n[0] * e1[1] - n[1] * e1[0];
 }
 
 /* motion_update: Kalman update of the offset b (P its covariance) from the turn of the low-passed
- * accelerometer from old to new (gyro frame); r_lp, rb_lp: LP(R) (row-major) and LP(R.b). Only
- * the directions across gravity that H = Pi.LP(R) keeps at least OBSERVED of are used, each as a
- * scalar measurement with variance W (see the Python twin). */
+ * accelerometer from old to new (gyro frame); r_lp, rb_lp: LP(R) (row-major) and LP(R.b).
+ * The turn rate plus Pi.LP(R.b^) measures H.b, H = Pi.LP(R) (the low-pass delays the turn after a
+ * change of b^); the innovation is clipped per component. H has rank 2 at most (Pi projects across
+ * gravity): its singular directions are those of the 2 x 2 problem in a basis (e1, e2) across
+ * gravity, in closed form. Only directions H keeps at least OBSERVED of are used, each as a scalar
+ * measurement u.e of (H^T u).b with variance W (u orthonormal: the joint update, taken one
+ * direction at a time). The basis and the directions are left unnormalised (e1, e2 of one length
+ * k, the 2 x 2 eigenvector of length L): a scalar measurement scaled by k.L, its variance by
+ * (k.L)^2, updates alike; that keeps square roots and divisions off the path from one sample's
+ * estimate to the next. */
 static void motion_update(double b[3], double P[9], const double old[3], const double new[3], const double r_lp[9],
                           const double rb_lp[3], double Ts, double W, double clip)
 {
     double n2 = dot(new, new);
     if (n2 == 0.0)
         return;
+    double e0[3], e1[3], e2[3];
+    across(new, e0);
     double norm = sqrt(n2);
-    double n[3] = {new[0] / norm, new[1] / norm, new[2] / norm};
-    double e1[3], e2[3];
-    plane_basis(n, e1, e2);
+    for (int i = 0; i < 3; i++)
+        e1[i] = norm * e0[i];
+    e2[0] = new[1] * e0[2] - new[2] * e0[1];
+    e2[1] = new[2] * e0[0] - new[0] * e0[2];
+    e2[2] = new[0] * e0[1] - new[1] * e0[0];
+    double k2 = n2 * dot(e0, e0); /* |e1|^2 = |e2|^2 */
     double b0[3] = {b[0], b[1], b[2]};
     double s = 1.0 / (n2 * Ts);
     double turn[3] = {(old[1] * new[2] - old[2] * new[1]) * s, (old[2] * new[0] - old[0] * new[2]) * s,
@@ -143,10 +151,10 @@ static void motion_update(double b[3], double P[9], const double old[3], const d
     double Lb[3];
     mat_vec(r_lp, b, Lb);
     double d[3] = {rb_lp[0] - Lb[0], rb_lp[1] - Lb[1], rb_lp[2] - Lb[2]}; /* LP(R.b) - LP(R).b, across gravity below */
-    double along = dot(d, n);
+    double along = dot(d, new) / n2;
     double e[3];
     for (int i = 0; i < 3; i++)
-        e[i] = clipped(turn[i] + d[i] - along * n[i], clip);
+        e[i] = clipped(turn[i] + d[i] - along * new[i], clip);
     /* M = (e1, e2)^T.LP(R), 2 x 3; the eigenvectors of M.M^T are H's left singular directions */
     double m1[3], m2[3];
     mat_t_vec(r_lp, e1, m1);
@@ -160,17 +168,15 @@ static void motion_update(double b[3], double P[9], const double old[3], const d
         c = half + radius, sn = p12;
     else
         c = p12, sn = radius - half;
-    double length = sqrt(c * c + sn * sn);
-    if (length > 0.0)
-        c = c / length, sn = sn / length;
-    else
-        c = 1.0, sn = 0.0;
+    double L2 = c * c + sn * sn;
+    if (L2 == 0.0)
+        c = 1.0, sn = 0.0, L2 = 1.0;
     for (int a = 0; a < 2; a++) {
         if (a == 1) {
             double c0 = c;
             c = -sn, sn = c0;
         }
-        if (mean + (a == 0 ? radius : -radius) < OBSERVED * OBSERVED)
+        if (mean + (a == 0 ? radius : -radius) < OBSERVED * OBSERVED * k2)
             continue;
         double u[3], h[3];
         for (int i = 0; i < 3; i++) {
@@ -179,74 +185,90 @@ static void motion_update(double b[3], double P[9], const double old[3], const d
         }
         /* u.e measures h.b at the b the innovation was taken at; later directions see the update */
         double z = dot(u, e) + dot(h, b0);
-        scalar_update(b, P, h, z, W);
+        scalar_update(b, P, h, z, W * L2 * k2);
     }
 }
 
-void gyro_offset_step(double state[GYRO_OFFSET_STATE_SIZE], const double coef[GYRO_OFFSET_COEF_SIZE],
-                      const double gyr[3], const double acc[3], double offset[3], double variance[3])
+/* unit: q scaled to unit norm where it is that to rounding (one Newton step), else exactly */
+static Quat unit(Quat q)
 {
-    double Ts = coef[0], a_lp = coef[1], r = coef[2], rest_gyr = coef[3], rest_gyr_abs = coef[4];
-    double rest_acc = coef[5], rest_time = coef[6], wt = coef[7], P0 = coef[8], V = coef[9], W = coef[10];
-    double a_short = coef[11];
-    double start_mean = sqrt(2.0) * Ts / wt; /* tau_acc */
-    double settle = SETTLE_TAUS * start_mean;
-    double clip = CLIP_SIGMAS * sqrt(P0);
-    double Ad[4], Bd[2];
-    butterworth_zoh(wt, Ad, Bd);
-    double *b = state + 7, *acc_lp = state + ACC_LP, *r_lp = state + R_LP, *rb_lp = state + RB_LP, *P = state + COV;
+    double n2 = q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z;
+    if (fabs(n2 - 1.0) > 1e-9)
+        return quat_normalized(q);
+    double k = 1.5 - 0.5 * n2;
+    return (Quat){q.w * k, q.x * k, q.y * k, q.z * k};
+}
+
+void gyro_offset_step(AfGyroOffset *state, const AfGyroOffsetCoef *coef, const double gyr_in[3], const double acc_in[3],
+                      double offset[3], double variance[3])
+{
+    double Ts = coef->Ts, V = coef->V;
+    const double gyr[3] = {gyr_in[0], gyr_in[1], gyr_in[2]}, acc[3] = {acc_in[0], acc_in[1], acc_in[2]};
+    double b[3], P[9]; /* the offset estimate and its covariance, written back at the end */
+    for (int i = 0; i < 3; i++)
+        b[i] = state->b[i];
+    for (int i = 0; i < 9; i++)
+        P[i] = state->P[i];
     double dg2 = 0.0, da2 = 0.0, g2 = 0.0;
     for (int i = 0; i < 3; i++) {
-        state[i] += a_lp * (gyr[i] - state[i]);
-        state[3 + i] += a_lp * (acc[i] - state[3 + i]);
-        state[SHORT + i] += a_short * (gyr[i] - state[SHORT + i]);
-        state[SHORT + 3 + i] += a_short * (acc[i] - state[SHORT + 3 + i]);
-        double dg = state[SHORT + i] - state[i], da = state[SHORT + 3 + i] - state[3 + i];
+        state->lp_gyr[i] += coef->a_lp * (gyr[i] - state->lp_gyr[i]);
+        state->lp_acc[i] += coef->a_lp * (acc[i] - state->lp_acc[i]);
+        state->short_gyr[i] += coef->a_short * (gyr[i] - state->short_gyr[i]);
+        state->short_acc[i] += coef->a_short * (acc[i] - state->short_acc[i]);
+        double dg = state->short_gyr[i] - state->lp_gyr[i], da = state->short_acc[i] - state->lp_acc[i];
         dg2 += dg * dg;
         da2 += da * da;
-        g2 += state[i] * state[i];
+        g2 += state->lp_gyr[i] * state->lp_gyr[i];
     }
-    int still = dg2 < rest_gyr * rest_gyr && da2 < rest_acc * rest_acc && g2 < rest_gyr_abs * rest_gyr_abs;
-    state[6] = still ? state[6] + Ts : 0.0;
-    double old[3] = {acc_lp[0], acc_lp[1], acc_lp[2]};
+    int still = dg2 < coef->rest_gyr * coef->rest_gyr && da2 < coef->rest_acc * coef->rest_acc &&
+                g2 < coef->rest_gyr_abs * coef->rest_gyr_abs;
+    state->rest = still ? state->rest + Ts : 0.0;
+    double old[3] = {state->acc_lp[0][0], state->acc_lp[0][1], state->acc_lp[0][2]};
     if (V > 0.0) { /* tracking while moving: the gyro frame and its low-passes */
-        Quat q = quat_normalized(quat_multiply( /* turned by the corrected gyro */
-            quat_load(state + QUAT),
-            rotvec_quat((gyr[0] - b[0]) * Ts, (gyr[1] - b[1]) * Ts, (gyr[2] - b[2]) * Ts)));
-        quat_store(q, state + QUAT);
-        state[T] += Ts;
+        Quat q = unit(quat_multiply( /* turned by the corrected gyro */
+            quat_load(state->q), rotvec_quat((gyr[0] - b[0]) * Ts, (gyr[1] - b[1]) * Ts, (gyr[2] - b[2]) * Ts)));
+        quat_store(q, state->q);
+        double t = state->t += Ts;
         /* the accelerometer, R.b and R (row-major) low-passed */
         double R[9], a[3], rb[3];
         quat_matrix(q, R);
         mat_vec(R, acc, a);
         mat_vec(R, b, rb);
-        int mean = state[T] <= start_mean;
-        for (int i = 0; i < 3; i++) {
-            if (mean) { /* the running mean, derivative row at rest */
-                acc_lp[i] += Ts / state[T] * (a[i] - acc_lp[i]);
-                acc_lp[3 + i] = 0.0;
-            } else {
-                lowpass_step(acc_lp, 3, i, a[i], Ad, Bd);
+        if (t <= coef->tau_acc) { /* the running mean, derivative row at rest */
+            double w = Ts / t;
+            for (int i = 0; i < 3; i++) {
+                state->acc_lp[0][i] += w * (a[i] - state->acc_lp[0][i]);
+                state->acc_lp[1][i] = 0.0;
             }
-            lowpass_step(rb_lp, 3, i, rb[i], Ad, Bd);
+        } else {
+            lowpass_rows(state->acc_lp[0], state->acc_lp[1], 3, a, coef->Ad, coef->Bd);
         }
-        for (int i = 0; i < 9; i++)
-            lowpass_step(r_lp, 9, i, R[i], Ad, Bd);
+        lowpass_rows(state->r_lp[0], state->r_lp[1], 9, R, coef->Ad, coef->Bd);
+        lowpass_rows(state->rb_lp[0], state->rb_lp[1], 3, rb, coef->Ad, coef->Bd);
     }
     for (int i = 0; i < 3; i++) {
         double p = P[4 * i] + V;
-        P[4 * i] = P0 < p ? P0 : p;
+        P[4 * i] = coef->P0 < p ? coef->P0 : p;
     }
-    if (state[6] >= rest_time) { /* each axis of the gyro sample measures b with variance r */
+    if (state->rest >= coef->rest_time) { /* each axis of the gyro sample measures b with variance r */
         for (int i = 0; i < 3; i++) {
             double h[3] = {i == 0 ? 1.0 : 0.0, i == 1 ? 1.0 : 0.0, i == 2 ? 1.0 : 0.0};
-            scalar_update(b, P, h, gyr[i], r);
+            scalar_update(b, P, h, gyr[i], coef->r);
         }
-    } else if (V > 0.0 && state[T] > settle) {
-        motion_update(b, P, old, acc_lp, r_lp, rb_lp, Ts, W, clip);
+    } else if (V > 0.0 && state->t > coef->settle) {
+        motion_update(b, P, old, state->acc_lp[0], state->r_lp[0], state->rb_lp[0], Ts, coef->W, coef->clip);
     }
     for (int i = 0; i < 3; i++) {
-        offset[i] = b[i];
+        state->b[i] = offset[i] = b[i];
         variance[i] = P[4 * i];
     }
+    for (int i = 0; i < 9; i++)
+        state->P[i] = P[i];
+}
+
+void gyro_offset_run(AfGyroOffset *state, const AfGyroOffsetCoef *coef, size_t n, const double *gyr,
+                     const double *acc, double *offset, double *variance)
+{
+    for (size_t k = 0; k < n; k++)
+        gyro_offset_step(state, coef, gyr + 3 * k, acc + 3 * k, offset + 3 * k, variance + 3 * k);
 }

@@ -1,25 +1,59 @@
 /* gyro_offset.h: the gyroscope-offset estimator (rest detection, the Kalman filter at rest,
- * the tracking while moving). Python twin: blocks/stages/gyro_offset.py. */
+ * the tracking while moving), documented in blocks/stages/gyro_offset.py. */
 #ifndef AF_GYRO_OFFSET_H
 #define AF_GYRO_OFFSET_H
 
+#include <stddef.h>
+
 #include "af_params.h"
+#include "stages/fields.h"
 
-#define GYRO_OFFSET_STATE_SIZE 60 /* len(STATE_NAMES) */
-#define GYRO_OFFSET_COEF_SIZE 12  /* see gyro_offset_coefficients */
-#define REST_NOISE_SIGMAS 4.5     /* the least rest_gyr in units of the gyro noise's per-axis s.d. through tau_short */
+#define REST_NOISE_SIGMAS 4.5 /* the least rest_gyr in units of the gyro noise's per-axis s.d. through tau_short */
 
-/* coefficients: [Ts, a_lp, r, rest_gyr, rest_gyr_abs, rest_acc, rest_time, w_acc*Ts, P0, V, W, a_short]
- * from the stage's resolved parameters (AF_P_<name>) at Ts (s). */
-void gyro_offset_coefficients(const double params[AF_N_PARAMS], double Ts, double coef[GYRO_OFFSET_COEF_SIZE]);
+/* The estimator's state: the gyro (rad/s) and the accelerometer (m/s^2) low-passed over tau_lp,
+ * and through the short low-pass; the time at rest (s); the offset estimate b (rad/s) and its
+ * covariance P ((rad/s)^2, row-major); the time since the start (s); q, sensor -> gyro frame; the
+ * Butterworth's two rows (value, derivative) of the accelerometer in the gyro frame, of R
+ * (row-major) and of R.b. */
+#define GYRO_OFFSET_FIELDS(X)                                                                                     \
+    X(lp_gyr, [3]) X(lp_acc, [3]) X(short_gyr, [3]) X(short_acc, [3]) X(rest, ) X(b, [3]) X(P, [9]) X(t, )           \
+    X(q, [4]) X(acc_lp, [2][3]) X(r_lp, [2][9]) X(rb_lp, [2][3])
+typedef struct {
+    GYRO_OFFSET_FIELDS(AF_DOUBLES)
+} AfGyroOffset;
+extern const AfField GYRO_OFFSET_STATE_FIELDS[];
+extern const size_t GYRO_OFFSET_N_FIELDS;
+
+/* Its coefficients at one sample time (gyro_offset_coefficients). */
+typedef struct {
+    double Ts;               /* s */
+    double a_lp, a_short;    /* 1 - exp(-Ts/tau_lp), 1 - exp(-Ts/tau_short) */
+    double r;                /* delta_n^2/(2 Ts): a gyro sample's variance at rest ((rad/s)^2) */
+    double rest_gyr;         /* rest_gyr, at least REST_NOISE_SIGMAS delta_n/sqrt(4 tau_short) (rad/s) */
+    double rest_gyr_abs, rest_acc, rest_time;
+    double P0;               /* sigma_init^2 */
+    double V;                /* sigma_motion^2 Ts/tau_motion, the process noise per sample (0: no tracking) */
+    double W;                /* sigma_motion^4/V + sigma_motion^2, the measurement noise while moving */
+    double Ad[4], Bd[2];     /* the zero-order hold of the accelerometer's Butterworth at sqrt 2/tau_acc */
+    double tau_acc, settle;  /* s: the running mean's time, and no update before settle = 3 tau_acc */
+    double clip;             /* the innovations' clip, 4 sigma_init (rad/s) */
+} AfGyroOffsetCoef;
+
+/* coefficients: from the stage's resolved parameters (AF_P_<name>) at Ts (s); 0, or -1 where one
+ * is not finite (they overflow at this Ts). */
+int gyro_offset_coefficients(const double params[AF_N_PARAMS], double Ts, AfGyroOffsetCoef *coef);
 
 /* initial_state: low-passes on the first samples gyr0 (rad/s), acc0 (m/s^2), no offset. */
-void gyro_offset_initial_state(const double coef[GYRO_OFFSET_COEF_SIZE], const double gyr0[3], const double acc0[3],
-                               double state[GYRO_OFFSET_STATE_SIZE]);
+void gyro_offset_initial_state(const AfGyroOffsetCoef *coef, const double gyr0[3], const double acc0[3],
+                               AfGyroOffset *state);
 
-/* One sample of run (gyr rad/s, acc m/s^2): state in place; the offset estimate after it
- * (rad/s) and its variance per axis ((rad/s)^2). */
-void gyro_offset_step(double state[GYRO_OFFSET_STATE_SIZE], const double coef[GYRO_OFFSET_COEF_SIZE],
-                      const double gyr[3], const double acc[3], double offset[3], double variance[3]);
+/* One sample (gyr rad/s, acc m/s^2): state in place; the offset estimate after it (rad/s) and its
+ * variance per axis ((rad/s)^2). */
+void gyro_offset_step(AfGyroOffset *state, const AfGyroOffsetCoef *coef, const double gyr[3], const double acc[3],
+                      double offset[3], double variance[3]);
+
+/* gyro_offset_step over n samples, rows of 3: gyr, acc in; offset, variance out. */
+void gyro_offset_run(AfGyroOffset *state, const AfGyroOffsetCoef *coef, size_t n, const double *gyr,
+                     const double *acc, double *offset, double *variance);
 
 #endif

@@ -1,18 +1,33 @@
-/* hard_iron.h: the magnetometer's hard-iron offset, fitted online as a sphere (the online part;
- * back_dated is batch only). Python twin: blocks/stages/hard_iron.py. */
+/* hard_iron.h: the magnetometer's hard-iron offset, fitted online as a sphere, documented in
+ * blocks/stages/hard_iron.py (which holds the batch-only back_dated). */
 #ifndef AF_HARD_IRON_H
 #define AF_HARD_IRON_H
 
 #include "af_params.h"
 #include "quaternion.h"
+#include "stages/fields.h"
 
-#define HARD_IRON_STATE_SIZE 23  /* STATE_SIZE */
-#define HARD_IRON_COEF_SIZE 6    /* COEF_SIZE */
-#define HARD_IRON_STATE_OFFSET 15 /* OFFSET.start: the offset in use in 3 entries from here */
+/* The fit's state: the sums of 1, m, m.m^T (xx, xy, xz, yy, yz, zz), m.|m|^2, |m|^2, |m|^4 over the
+ * field samples, forgotten over mag_cal_time; the offset in use (the field's unit); the steps the
+ * fit, or the field as it is, has held steady; the latest samples' mean square distance from
+ * either sphere, relative to its radius; the steps since the sums started afresh. */
+#define HARD_IRON_FIELDS(X)                                                                                        \
+    X(sums, [15]) X(offset, [3]) X(fit_steps, ) X(raw_steps, ) X(recent_fit, ) X(recent_raw, ) X(age, )
+typedef struct {
+    HARD_IRON_FIELDS(AF_DOUBLES)
+} AfHardIron;
+extern const AfField HARD_IRON_STATE_FIELDS[];
+extern const size_t HARD_IRON_N_FIELDS;
 
-/* coefficients: [mag_cal_time/Ts, mag_cal_spread, mag_cal_tol, mag_cal_recent/Ts,
- * 1 - exp(-Ts/mag_cal_time) (0 when off), 1 - exp(-Ts/mag_cal_recent)]. */
-void hard_iron_coefficients(const double params[AF_N_PARAMS], double Ts, double coef[HARD_IRON_COEF_SIZE]);
+/* Its coefficients at one step time Ts. */
+typedef struct {
+    double cal_steps;           /* mag_cal_time/Ts (steps; 0: no fit) */
+    double spread_min, tol;     /* mag_cal_spread, mag_cal_tol */
+    double a_cal, a_recent;     /* 1 - exp(-Ts/mag_cal_time) (0 when off), 1 - exp(-Ts/mag_cal_recent) */
+    double rate_cal, rate_recent; /* their rates per step: Ts/mag_cal_time (0 when off), Ts/mag_cal_recent */
+} AfHardIronCoef;
+
+void hard_iron_coefficients(const double params[AF_N_PARAMS], double Ts, AfHardIronCoef *coef);
 
 /* pull: 1 - exp(-gap*rate), a first-order low-pass's weight over gap steps; one_step its value for one. */
 double pull(double gap, double rate, double one_step);
@@ -20,7 +35,7 @@ double pull(double gap, double rate, double one_step);
 /* hard_iron_step: the field sample m (finite) less the offset estimate after updating it; *changed: 1
  * when the offset was taken or dropped at this sample. gap: steps since the last field sample;
  * norm_tol, steady_steps: the heading guard's norm tolerance and mag_new_time in steps. */
-Vec3 hard_iron_step(double state[HARD_IRON_STATE_SIZE], const double coef[HARD_IRON_COEF_SIZE], Vec3 m, double gap,
-                    double norm_tol, double steady_steps, int *changed);
+Vec3 hard_iron_step(AfHardIron *state, const AfHardIronCoef *coef, Vec3 m, double gap, double norm_tol,
+                    double steady_steps, int *changed);
 
 #endif

@@ -1,45 +1,36 @@
-/* heading.c: Python twin blocks/stages/heading.py; the same operations in the same order. */
+/* heading.c: heading from the magnetometer with its guard (documented in blocks/stages/heading.py). */
 #include "stages/heading.h"
 
 #include <math.h>
+#include <string.h>
 
-/* the state's layout (STATE_NAMES; see heading_initial_state): psi_c 0 (rad) */
-#define REF_NORM 1    /* reference norm */
-#define REF_DIP 2     /* reference dip (rad) */
-#define SEEN 3        /* field samples since the start-up began */
-#define CAND_NORM 4   /* candidate norm */
-#define CAND_DIP 5    /* candidate dip (rad) */
-#define CAND_N 6      /* field samples in the candidate */
-#define CAND_DOT 7    /* smallest |q.q0| since the candidate began */
-#define CAND_Q0 8     /* q0, the orientation then, 4 entries */
-#define STEPS 12      /* steps since the start-up began */
-#define CAND_START 13 /* the step the candidate began at */
-#define GAP 14        /* steps since the last field sample */
-#define Q_PREV 15     /* the last step's orientation, 4 entries (0: none yet) */
+#define STATE_FIELD(name, dims) AF_FIELD(AfHeading, name)
+const AfField HEADING_STATE_FIELDS[] = {HEADING_FIELDS(STATE_FIELD)};
+const size_t HEADING_N_FIELDS = sizeof HEADING_STATE_FIELDS / sizeof HEADING_STATE_FIELDS[0];
 
 static const double PI = 3.14159265358979323846;
 
-void heading_coefficients(const double params[AF_N_PARAMS], double Ts, double coef[HEADING_COEF_SIZE])
+int heading_coefficients(const double params[AF_N_PARAMS], double Ts, AfHeadingCoef *coef)
 {
-    coef[0] = Ts / params[AF_P_tau_heading];
-    coef[1] = Ts / params[AF_P_tau_reference];
-    coef[2] = params[AF_P_mag_norm_tol];
-    coef[3] = params[AF_P_mag_dip_tol];
-    coef[4] = params[AF_P_heading_clip];
-    coef[5] = params[AF_P_mag_new_time] / Ts;
-    coef[6] = cos(0.5 * params[AF_P_mag_new_angle]);
-    coef[7] = 1.0 - exp(-Ts / params[AF_P_tau_heading]);
-    coef[8] = 1.0 - exp(-Ts / params[AF_P_tau_reference]);
-    coef[9] = params[AF_P_mag_delay]; /* NaN: unset, estimated online */
-    hard_iron_coefficients(params, Ts, coef + HARD_IRON_COEF);
-    mag_delay_coefficients(params, Ts, coef + MAG_DELAY_COEF);
+    coef->rate_heading = Ts / params[AF_P_tau_heading];
+    coef->rate_reference = Ts / params[AF_P_tau_reference];
+    coef->a_heading = 1.0 - exp(-Ts / params[AF_P_tau_heading]);
+    coef->a_reference = 1.0 - exp(-Ts / params[AF_P_tau_reference]);
+    coef->norm_tol = params[AF_P_mag_norm_tol];
+    coef->dip_tol = params[AF_P_mag_dip_tol];
+    coef->clip = params[AF_P_heading_clip];
+    coef->new_steps = params[AF_P_mag_new_time] / Ts;
+    coef->cos_half_turn = cos(0.5 * params[AF_P_mag_new_angle]);
+    coef->delay = params[AF_P_mag_delay];
+    hard_iron_coefficients(params, Ts, &coef->hard_iron);
+    mag_delay_coefficients(params, Ts, &coef->mag_delay);
+    return af_finite(coef, sizeof *coef, &coef->delay) ? 0 : -1;
 }
 
-void heading_initial_state(double state[HEADING_STATE_SIZE])
+void heading_initial_state(AfHeading *state)
 {
-    for (int i = 0; i < HEADING_STATE_SIZE; i++)
-        state[i] = 0.0;
-    state[CAND_DOT] = 1.0;
+    memset(state, 0, sizeof *state);
+    state->cand_dot = 1.0;
 }
 
 static int steady(double norm, double dip, double ref_norm, double ref_dip, double norm_tol, double dip_tol)
@@ -50,78 +41,95 @@ static int steady(double norm, double dip, double ref_norm, double ref_dip, doub
 /* new_reference: a sample outside the reference's tolerance extends the candidate field (or begins
  * one); 1 when the candidate has stayed steady for mag_new_time while the sensor turned through
  * mag_new_angle: the heading estimator then starts afresh */
-static int new_reference(double *state, const double *coef, Quat q, double norm, double dip)
+static int new_reference(AfHeading *state, const AfHeadingCoef *coef, Quat q, double norm, double dip)
 {
-    double norm_tol = coef[2], dip_tol = coef[3], steps = coef[5], cos_half = coef[6];
-    if (state[CAND_N] > 0.0 && steady(norm, dip, state[CAND_NORM], state[CAND_DIP], norm_tol, dip_tol)) {
-        state[CAND_N] += 1.0;
-        state[CAND_NORM] += (norm - state[CAND_NORM]) / state[CAND_N];
-        state[CAND_DIP] += (dip - state[CAND_DIP]) / state[CAND_N];
+    if (state->cand_n > 0.0 && steady(norm, dip, state->cand_norm, state->cand_dip, coef->norm_tol, coef->dip_tol)) {
+        state->cand_n += 1.0;
+        state->cand_norm += (norm - state->cand_norm) / state->cand_n;
+        state->cand_dip += (dip - state->cand_dip) / state->cand_n;
         double dot = 0.0;
-        dot += q.w * state[CAND_Q0];
-        dot += q.x * state[CAND_Q0 + 1];
-        dot += q.y * state[CAND_Q0 + 2];
-        dot += q.z * state[CAND_Q0 + 3];
+        dot += q.w * state->cand_q0[0];
+        dot += q.x * state->cand_q0[1];
+        dot += q.y * state->cand_q0[2];
+        dot += q.z * state->cand_q0[3];
         double turned = fabs(dot);
-        state[CAND_DOT] = turned < state[CAND_DOT] ? turned : state[CAND_DOT];
-        if (state[STEPS] - state[CAND_START] + 1.0 >= steps && state[CAND_DOT] <= cos_half) {
-            state[CAND_N] = 0.0;
+        state->cand_dot = turned < state->cand_dot ? turned : state->cand_dot;
+        if (state->steps - state->cand_start + 1.0 >= coef->new_steps && state->cand_dot <= coef->cos_half_turn) {
+            state->cand_n = 0.0;
             return 1;
         }
         return 0;
     }
-    state[CAND_NORM] = norm, state[CAND_DIP] = dip, state[CAND_N] = 1.0, state[CAND_DOT] = 1.0;
-    state[CAND_START] = state[STEPS];
-    quat_store(q, state + CAND_Q0);
+    state->cand_norm = norm, state->cand_dip = dip, state->cand_n = 1.0, state->cand_dot = 1.0;
+    state->cand_start = state->steps;
+    quat_store(q, state->cand_q0);
     return 0;
 }
 
-/* field_sample: the field m (earth frame, turned by psi_c; its horizontal norm > 0) taken into
- * psi_c and the reference; whether it was used */
-static int field_sample(double *state, const double *coef, Quat q, Vec3 m, double horizontal)
+/* heading_error: atan2(x, y) of the field m turned about up by psi (rad): the heading error's negative */
+static double heading_error(Vec3 m, double psi)
 {
-    double clip = coef[4];
+    double error = atan2(m.x, m.y) - psi; /* within (-2 pi, 2 pi): psi is kept within [-pi, pi] */
+    return error > PI ? error - 2.0 * PI : error < -PI ? error + 2.0 * PI : error;
+}
+
+/* field_sample: the field m (earth frame before the turn by psi_c about up, which leaves its norm,
+ * horizontal norm (> 0) and dip alone) taken into psi_c and the reference; whether it was used */
+static int field_sample(AfHeading *state, const AfHeadingCoef *coef, Quat q, Vec3 m, double horizontal)
+{
+    double clip = coef->clip;
     double norm = sqrt(horizontal * horizontal + m.z * m.z);
     double dip = atan2(-m.z, horizontal);
-    double gap = state[GAP];
-    state[GAP] = 0.0;
-    if (state[SEEN] == 0.0)
-        state[STEPS] = 1.0;
-    state[SEEN] += 1.0;
-    int start = 1.0 / state[STEPS] > coef[7]; /* within tau_heading of the start */
+    double gap = state->gap;
+    state->gap = 0.0;
+    if (state->seen == 0.0)
+        state->steps = 1.0;
+    state->seen += 1.0;
+    int start = 1.0 / state->steps > coef->a_heading; /* within tau_heading of the start */
     int ok = 0;
     if (!start) {
-        ok = steady(norm, dip, state[REF_NORM], state[REF_DIP], coef[2], coef[3]);
+        ok = steady(norm, dip, state->ref_norm, state->ref_dip, coef->norm_tol, coef->dip_tol);
         if (ok) {
-            state[CAND_N] = 0.0;
+            state->cand_n = 0.0;
         } else if (new_reference(state, coef, q, norm, dip)) {
-            state[SEEN] = 1.0, state[STEPS] = 1.0, start = 1; /* a proven field: start afresh */
+            state->seen = 1.0, state->steps = 1.0, start = 1; /* a proven field: start afresh */
         }
     }
     if (start) { /* running means, every sample */
         ok = 1;
-        state[0] += atan2(m.x, m.y) / state[SEEN];
-        state[REF_NORM] += (norm - state[REF_NORM]) / state[SEEN];
-        state[REF_DIP] += (dip - state[REF_DIP]) / state[SEEN];
+        state->psi_c += heading_error(m, state->psi_c) / state->seen;
+        state->ref_norm += (norm - state->ref_norm) / state->seen;
+        state->ref_dip += (dip - state->ref_dip) / state->seen;
     } else if (ok) { /* first-order pulls over the time since the last field sample */
-        double error = atan2(m.x, m.y);
+        double error = heading_error(m, state->psi_c);
         double low = error > -clip ? error : -clip;
-        state[0] += pull(gap, coef[0], coef[7]) * (low < clip ? low : clip);
-        double a_reference = pull(gap, coef[1], coef[8]);
-        state[REF_NORM] += a_reference * (norm - state[REF_NORM]);
-        state[REF_DIP] += a_reference * (dip - state[REF_DIP]);
+        state->psi_c += pull(gap, coef->rate_heading, coef->a_heading) * (low < clip ? low : clip);
+        double a_reference = pull(gap, coef->rate_reference, coef->a_reference);
+        state->ref_norm += a_reference * (norm - state->ref_norm);
+        state->ref_dip += a_reference * (dip - state->ref_dip);
     }
     return ok;
 }
 
-/* step_turn: the rotation vector (rad, sensor frame) from q_prev to q */
+/* step_turn: the rotation vector (rad, sensor frame) from q_prev to q: d = q_prev^-1 (x) q has the
+ * angle 2 atan2(|v|, w) about v = (d.x, d.y, d.z); for a small step (|v| < w/10) atan(t)/t,
+ * t = |v|/w, by its series (exact to double precision there) */
 static Vec3 step_turn(Quat q_prev, Quat q)
 {
     Quat d = quat_multiply(quat_conjugate(q_prev), q);
     if (d.w < 0.0)
         d = (Quat){-d.w, -d.x, -d.y, -d.z};
-    double s = sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
-    double k = s > 0.0 ? 2.0 * atan2(s, d.w) / s : 2.0;
+    double v2 = d.x * d.x + d.y * d.y + d.z * d.z, k;
+    if (v2 < 1e-2 * d.w * d.w) {
+        double inv_w = 1.0 / d.w, t2 = v2 * inv_w * inv_w;
+        double t4 = t2 * t2, t8 = t4 * t4; /* the terms in pairs, the pairs in pairs (Estrin's scheme) */
+        double low = (1.0 - t2 * (1.0 / 3.0)) + t4 * (1.0 / 5.0 - t2 * (1.0 / 7.0));
+        double high = (1.0 / 9.0 - t2 * (1.0 / 11.0)) + t4 * (1.0 / 13.0 - t2 * (1.0 / 15.0));
+        k = 2.0 * inv_w * (low + t8 * high);
+    } else {
+        double s = sqrt(v2);
+        k = 2.0 * atan2(s, d.w) / s;
+    }
     return (Vec3){k * d.x, k * d.y, k * d.z};
 }
 
@@ -138,45 +146,59 @@ static Quat about_up(double psi, Quat q)
     return quat_multiply((Quat){cos(half), 0.0, 0.0, sin(half)}, q);
 }
 
-Quat heading_step(double state[HEADING_STATE_SIZE], const double coef[HEADING_COEF_SIZE], Quat q, Vec3 m_sensor,
-                  int *ok)
+Quat heading_step(AfHeading *state, const AfHeadingCoef *coef, Quat q, Vec3 m_sensor, int *ok)
 {
-    state[GAP] += 1.0;
-    if (state[SEEN] > 0.0)
-        state[STEPS] += 1.0;
+    state->gap += 1.0;
+    if (state->seen > 0.0)
+        state->steps += 1.0;
     *ok = 0;
-    int online = isnan(coef[9]);
+    int online = isnan(coef->delay);
     if (!online)
-        state[MAG_DELAY_IN_USE] = coef[9];
-    const double *delay_coef = coef + MAG_DELAY_COEF;
-    Quat q_prev = quat_load(state + Q_PREV);
+        state->mag_delay.delay = coef->delay;
+    double Ts = coef->mag_delay.Ts;
+    Quat q_prev = quat_load(state->q_prev);
     Vec3 turn = {0.0, 0.0, 0.0}; /* the last step's rotation (rad), wanted online or for a given delay */
-    if ((online || coef[9] != 0.0) && fabs(q_prev.w) + fabs(q_prev.x) + fabs(q_prev.y) + fabs(q_prev.z) > 0.0)
+    if ((online || coef->delay != 0.0) && fabs(q_prev.w) + fabs(q_prev.x) + fabs(q_prev.y) + fabs(q_prev.z) > 0.0)
         turn = step_turn(q_prev, q);
     if (online)
-        mag_delay_turn(state + MAG_DELAY, delay_coef, turn);
+        mag_delay_turn(&state->mag_delay, &coef->mag_delay, turn);
     double n2 = m_sensor.x * m_sensor.x + m_sensor.y * m_sensor.y + m_sensor.z * m_sensor.z;
     if (isfinite(n2) && n2 > 0.0) { /* a field sample (not NaN: missing, not all 0: none) */
         int proven;
-        m_sensor = hard_iron_step(state + HARD_IRON, coef + HARD_IRON_COEF, m_sensor, state[GAP], coef[2], coef[5],
-                                  &proven);
+        m_sensor = hard_iron_step(&state->hard_iron, &coef->hard_iron, m_sensor, state->gap, coef->norm_tol,
+                                  coef->new_steps, &proven);
         if (proven) { /* a field freed of (or back without) an offset: start afresh from it */
-            state[SEEN] = 0.0;
-            mag_delay_restart(state + MAG_DELAY);
+            state->seen = 0.0;
+            mag_delay_restart(&state->mag_delay);
         }
-        double steps = state[MAG_DELAY_IN_USE] / delay_coef[0];
+        double steps = state->mag_delay.delay / Ts;
         Quat q_field = steps != 0.0 ? turned_back(q, turn, steps) : q;
-        Vec3 m = quat_rotate(about_up(state[0], q_field), m_sensor);
+        Vec3 m = quat_rotate(q_field, m_sensor); /* turned by psi_c in field_sample */
         double horizontal = sqrt(m.x * m.x + m.y * m.y);
         if (horizontal > 0.0) /* a field with a heading */
             *ok = field_sample(state, coef, q, m, horizontal);
         if (online) {
-            Vec3 rate = {turn.x / delay_coef[0], turn.y / delay_coef[0], turn.z / delay_coef[0]};
-            mag_delay_field_sample(state + MAG_DELAY, delay_coef, m_sensor, rate, *ok);
+            Vec3 rate = {turn.x / Ts, turn.y / Ts, turn.z / Ts};
+            mag_delay_field_sample(&state->mag_delay, &coef->mag_delay, m_sensor, rate, *ok);
         }
     }
-    quat_store(q, state + Q_PREV);
-    if (fabs(state[0]) > PI)
-        state[0] = atan2(sin(state[0]), cos(state[0]));
-    return about_up(state[0], q);
+    quat_store(q, state->q_prev);
+    if (fabs(state->psi_c) > PI)
+        state->psi_c = atan2(sin(state->psi_c), cos(state->psi_c));
+    return about_up(state->psi_c, q);
+}
+
+void heading_run(AfHeading *state, const AfHeadingCoef *coef, size_t n, const double *quat, const double *mag,
+                 double *out, unsigned char *accepted, double *offset, double *delay)
+{
+    for (size_t k = 0; k < n; k++) {
+        const double *m = mag + 3 * k;
+        int ok;
+        Quat turned = heading_step(state, coef, quat_load(quat + 4 * k), (Vec3){m[0], m[1], m[2]}, &ok);
+        quat_store(turned, out + 4 * k);
+        accepted[k] = (unsigned char)ok;
+        for (int i = 0; i < 3; i++)
+            offset[3 * k + i] = state->hard_iron.offset[i];
+        delay[k] = state->mag_delay.delay;
+    }
 }

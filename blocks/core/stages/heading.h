@@ -1,33 +1,60 @@
 /* heading.h: heading from the magnetometer, freed of hard iron and of the magnetometer's delay,
- * guarded against disturbances. Python twin: blocks/stages/heading.py. */
+ * guarded against disturbances; documented in blocks/stages/heading.py. */
 #ifndef AF_HEADING_H
 #define AF_HEADING_H
 
+#include <stddef.h>
+
 #include "af_params.h"
 #include "quaternion.h"
+#include "stages/fields.h"
 #include "stages/hard_iron.h"
 #include "stages/mag_delay.h"
 
-#define HEADING_STATE_SIZE (19 + HARD_IRON_STATE_SIZE + MAG_DELAY_STATE_SIZE) /* len(STATE_NAMES) */
-#define HEADING_COEF_SIZE (10 + HARD_IRON_COEF_SIZE + MAG_DELAY_COEF_SIZE)
-#define HARD_IRON 19                                  /* blocks.stages.hard_iron's state from here */
-#define HARD_IRON_OFFSET (HARD_IRON + HARD_IRON_STATE_OFFSET) /* its offset estimate in 3 entries from here */
-#define MAG_DELAY (HARD_IRON + HARD_IRON_STATE_SIZE)  /* blocks.stages.mag_delay's state from here */
-#define MAG_DELAY_IN_USE (MAG_DELAY + MAG_DELAY_STATE_DELAY) /* the delay allowed for (s) */
-#define HARD_IRON_COEF 10                             /* blocks.stages.hard_iron's coefficients from here */
-#define MAG_DELAY_COEF (HARD_IRON_COEF + HARD_IRON_COEF_SIZE)
+/* The stage's own state: psi_c, the heading correction (rad); the reference norm (the field's
+ * unit) and dip (rad); the field samples since the start-up began; the candidate field's norm,
+ * dip, field samples and smallest |q.q0| since it began, q0 the orientation then; the steps since
+ * the start-up began; the step the candidate began at; the steps since the last field sample; the
+ * last step's orientation (0: none yet). The hard-iron fit's and the delay's states follow. */
+#define HEADING_FIELDS(X)                                                                                          \
+    X(psi_c, ) X(ref_norm, ) X(ref_dip, ) X(seen, ) X(cand_norm, ) X(cand_dip, ) X(cand_n, ) X(cand_dot, )          \
+    X(cand_q0, [4]) X(steps, ) X(cand_start, ) X(gap, ) X(q_prev, [4])
+typedef struct {
+    HEADING_FIELDS(AF_DOUBLES)
+    AfHardIron hard_iron;
+    AfMagDelay mag_delay;
+} AfHeading;
+extern const AfField HEADING_STATE_FIELDS[];
+extern const size_t HEADING_N_FIELDS;
 
-/* coefficients: [Ts/tau_heading, Ts/tau_reference, mag_norm_tol, mag_dip_tol, heading_clip,
- * mag_new_time/Ts, cos(mag_new_angle/2), 1 - exp(-Ts/tau_heading), 1 - exp(-Ts/tau_reference),
- * mag_delay (s; NaN: estimated online)], then hard_iron's and mag_delay's. */
-void heading_coefficients(const double params[AF_N_PARAMS], double Ts, double coef[HEADING_COEF_SIZE]);
+/* Its coefficients at one step (IMU sample) time Ts. */
+typedef struct {
+    double rate_heading, rate_reference; /* Ts/tau_heading, Ts/tau_reference */
+    double a_heading, a_reference;       /* 1 - exp(-Ts/tau_heading), 1 - exp(-Ts/tau_reference) */
+    double norm_tol, dip_tol, clip;      /* mag_norm_tol, mag_dip_tol (rad), heading_clip (rad) */
+    double new_steps;                    /* mag_new_time/Ts */
+    double cos_half_turn;                /* cos(mag_new_angle/2) */
+    double delay;                        /* mag_delay (s); NaN: estimated online */
+    AfHardIronCoef hard_iron;
+    AfMagDelayCoef mag_delay;
+} AfHeadingCoef;
+
+/* coefficients: from the stage's resolved parameters (AF_P_<name>) at Ts (s); 0, or -1 where one is
+ * not finite (they overflow at this Ts; delay is NaN where mag_delay is unset). */
+int heading_coefficients(const double params[AF_N_PARAMS], double Ts, AfHeadingCoef *coef);
 
 /* initial_state: nothing seen yet. */
-void heading_initial_state(double state[HEADING_STATE_SIZE]);
+void heading_initial_state(AfHeading *state);
 
 /* heading_step: q (the attitude filter's orientation) turned by the updated heading correction;
- * *ok: whether the field m_sensor (a NaN: no sample this step) was used. state in place. */
-Quat heading_step(double state[HEADING_STATE_SIZE], const double coef[HEADING_COEF_SIZE], Quat q, Vec3 m_sensor,
-                  int *ok);
+ * *ok: whether the field m_sensor (a NaN: no sample this step) was used. state in place; its
+ * hard_iron.offset is the hard-iron estimate, mag_delay.delay the delay allowed for (s). */
+Quat heading_step(AfHeading *state, const AfHeadingCoef *coef, Quat q, Vec3 m_sensor, int *ok);
+
+/* heading_step over n samples: quat (rows of 4) and mag (rows of 3) in; out (rows of 4; may be quat),
+ * accepted (0 or 1), offset (rows of 3: the hard-iron estimate after each) and delay (the delay
+ * allowed for, s) out. */
+void heading_run(AfHeading *state, const AfHeadingCoef *coef, size_t n, const double *quat, const double *mag,
+                 double *out, unsigned char *accepted, double *offset, double *delay);
 
 #endif

@@ -1,6 +1,6 @@
 /* timing.h: sample timing: the gyro's and the accelerometer's sample conventions, latency
- * compensation, and when two sample times are one.
- * Python twin: blocks/stages/timing.py (same names). Units: rad/s, m/s^2, s. */
+ * compensation, and when two sample times are one; documented in blocks/stages/timing.py.
+ * Units: rad/s, m/s^2, s. */
 #ifndef AF_TIMING_H
 #define AF_TIMING_H
 
@@ -12,8 +12,11 @@
 #define STEP_TOLERANCE 1e-9
 #define MAX_LATENCY_S 0.5 /* s: the gyro's last rate is no guide to the orientation further ahead */
 
-/* 0, or -1 with Python's message unless gyr_samples is "mean" or "point" and acc_samples
- * "point" or "mean". */
+/* the gyro's sample conventions and the accelerometer's, the convention's first */
+extern const char *const GYR_SAMPLES[2];
+extern const char *const ACC_SAMPLES[2];
+
+/* 0, or -1 with the message unless gyr_samples is one of GYR_SAMPLES and acc_samples one of ACC_SAMPLES. */
 int check_samples(const char *gyr_samples, const char *acc_samples, char *message, size_t size);
 
 /* Whether the sample time Ts (s) is reference (s) up to STEP_TOLERANCE. */
@@ -22,7 +25,7 @@ int same_step(double Ts, double reference);
 /* The mean rate over the sample time between two point samples of it (rad/s): the trapezoid. */
 Vec3 interval_mean(Vec3 before, Vec3 now);
 
-/* 0, or -1 with Python's message unless latency (s) is finite and within +-MAX_LATENCY_S. */
+/* 0, or -1 with the message unless latency (s) is finite and within +-MAX_LATENCY_S. */
 int check_latency(double latency, char *message, size_t size);
 
 /* q (sensor -> earth) carried forward over latency (s) at the rate gyr (rad/s), q (x) exp(gyr
@@ -32,5 +35,11 @@ void carry_forward(Quat q, Vec3 up, Vec3 gyr, double latency, Quat *q_out, Vec3 
 /* acc (m/s^2), a mean over the sample time Ts (s), in the sensor frame at its end: turned as
  * carry_forward turns the up-vector over Ts/2 at the sample's mean rate gyr (rad/s). */
 Vec3 interval_end(Vec3 gyr, Vec3 acc, double Ts);
+
+/* carry_forward on n rows in place: quat (rows of 4) and gravity (rows of 3), at the rates gyr (rows of 3). */
+void carry_forward_rows(size_t n, double *quat, double *gravity, const double *gyr, double latency);
+
+/* interval_end on n rows: acc (rows of 3) at the rates gyr (rows of 3) into out (rows of 3). */
+void interval_ends(size_t n, const double *gyr, const double *acc, double Ts, double *out);
 
 #endif

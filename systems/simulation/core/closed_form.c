@@ -1,9 +1,10 @@
-/* closed_form.c: Python twin systems/simulation/motion.py (ClosedFormMotion.at and the closed-form
- * profiles). scipy's Rotation there is quaternion algebra here: the same products in the same
- * order, so the quaternions carry the same sign. */
-#include "sim/closed_form.h"
+/* closed_form.c: the closed-form profiles, in quaternion algebra: the products in the order of
+ * scipy's Rotation compositions that the profiles were written with, so the quaternions carry
+ * their sign. */
+#include "closed_form.h"
 
 #include <math.h>
+#include <string.h>
 
 #include "quaternion.h"
 
@@ -11,32 +12,42 @@
 #define STEP_LEVELS 10 /* STEP_SIZES_DEG, each followed by 0 */
 static const double STEP_SIZES_DEG[STEP_LEVELS / 2] = {5.0, 10.0, 20.0, 45.0, 90.0};
 
+const char *const CLOSED_FORM_NAMES[N_CLOSED_FORMS] = {
+    "lever_arm", "incline", "coning", "sine_rotation", "step_rotation", "linear_motion", "offset_rotation",
+};
+
 static double radians(double degrees) { return degrees * (PI / 180.0); }
 
-/* the rotation about a coordinate axis (0 x, 1 y, 2 z) by angle (rad): motion.py's _rot */
+/* the rotation about a coordinate axis (0 x, 1 y, 2 z) by angle (rad) */
 static Quat rot(int axis, double angle) {
     return rotvec_quat(axis == 0 ? angle : 0.0, axis == 1 ? angle : 0.0, axis == 2 ? angle : 0.0);
 }
 
 /* Rotation.from_euler("xy", [a, b], degrees=True): about the fixed x, then the fixed y */
-static Quat extrinsic_xy(double a_deg, double b_deg) { return quat_multiply(rot(1, radians(b_deg)), rot(0, radians(a_deg))); }
+static Quat extrinsic_xy(double a_deg, double b_deg) {
+    return quat_multiply(rot(1, radians(b_deg)), rot(0, radians(a_deg)));
+}
 
 /* Rotation.from_euler("XYZ", [a, b, c], degrees=True): about x, then the new y, then the new z */
 static Quat intrinsic_xyz(double a_deg, double b_deg, double c_deg) {
     return quat_multiply(quat_multiply(rot(0, radians(a_deg)), rot(1, radians(b_deg))), rot(2, radians(c_deg)));
 }
 
-/* step_rotation's level i (rad): STEP_SIZES_DEG, each followed by 0, repeated (i of any sign) */
-static double step_level(long i) {
-    long n = (i % STEP_LEVELS + STEP_LEVELS) % STEP_LEVELS;
-    return n % 2 ? 0.0 : radians(STEP_SIZES_DEG[n / 2]);
+/* step_rotation's level i (rad; i a whole number of any sign): STEP_SIZES_DEG, each followed by 0,
+ * repeated; NaN where i is not finite */
+static double step_level(double i) {
+    double n = fmod(i, STEP_LEVELS);
+    if (n < 0.0) n += STEP_LEVELS;
+    if (!(n >= 0.0 && n < STEP_LEVELS)) return NAN;
+    int level = (int)n;
+    return level % 2 ? 0.0 : radians(STEP_SIZES_DEG[level / 2]);
 }
 
 /* step_rotation's pitch (rad) at t */
 static double step_pitch(double hold, double ramp, double t) {
     double i = floor(t / hold);
     double into = t - i * hold;
-    double now = step_level((long)i), before = step_level((long)i - 1);
+    double now = step_level(i), before = step_level(i - 1.0);
     double blend = into < ramp ? 0.5 - 0.5 * cos(PI * fmin(fmax(into / ramp, 0.0), 1.0)) : 1.0;
     return t < hold ? now * blend : before + (now - before) * blend;
 }
@@ -89,6 +100,12 @@ static Vec3 rotvec(Quat q) {
     return (Vec3){scale * q.x, scale * q.y, scale * q.z};
 }
 
+int closed_form_profile(const char *name) {
+    for (int profile = 0; profile < N_CLOSED_FORMS; profile++)
+        if (strcmp(CLOSED_FORM_NAMES[profile], name) == 0) return profile;
+    return -1;
+}
+
 void closed_form_at(const ClosedForm *m, double t, double h, double gyr[3], double f[3], double quat[4]) {
     Quat now = orientation(m, t), before = orientation(m, t - h);
     Vec3 r = rotvec(quat_multiply(quat_conjugate(before), now));
@@ -98,4 +115,8 @@ void closed_form_at(const ClosedForm *m, double t, double h, double gyr[3], doub
     Vec3 sensor = quat_rotate(quat_conjugate(now), acc);
     f[0] = sensor.x, f[1] = sensor.y, f[2] = sensor.z;
     quat[0] = now.w, quat[1] = now.x, quat[2] = now.y, quat[3] = now.z;
+}
+
+void closed_form_run(const ClosedForm *m, const double *t, size_t n, double h, double *gyr, double *f, double *quat) {
+    for (size_t k = 0; k < n; k++) closed_form_at(m, t[k], h, gyr + 3 * k, f + 3 * k, quat + 4 * k);
 }

@@ -1,33 +1,58 @@
 /* closed_form.h: the motions given by closed forms of orientation R(t) (sensor -> earth) and
  * earth-frame velocity v(t), sampled over (t - h, t]: gyr is the rotation vector of R(t-h)^T R(t)
- * over h, the specific force R(t)^T ((v(t) - v(t-h))/h + g z).
- * Python twin: systems/simulation/motion.py (ClosedFormMotion.at and the profiles steady_lever_arm,
- * incline_oscillation, coning, sine_rotation, step_rotation, linear_motion, offset_rotation). */
+ * over h (so integrating it reproduces R exactly), the specific force R(t)^T ((v(t) - v(t-h))/h + g z).
+ * The profiles' names and parameters: systems/simulation/profile_table.py; bound into Python by
+ * systems/simulation/motion.py (ClosedForm). */
 #ifndef SIM_CLOSED_FORM_H
 #define SIM_CLOSED_FORM_H
+
+#include <stddef.h>
 
 #define CLOSED_FORM_MAX_PARAMS 5
 
 typedef enum {
-    LEVER_ARM,       /* rate (rad/s), radius (m) */
-    INCLINE,         /* incline_deg, peak_acc_g (1), frequency (Hz) */
-    CONING,          /* theta (rad), rate (rad/s) */
-    SINE_ROTATION,   /* amplitude_deg, frequency (Hz), inclination_deg */
-    STEP_ROTATION,   /* hold (s), ramp (s) */
-    LINEAR_MOTION,   /* amplitude (m), period (s), mount_x_deg, mount_y_deg, mount_z_deg */
-    OFFSET_ROTATION, /* frequency (Hz), amplitude_deg, radius (m), inclination_deg, pitch_deg */
+    /* Rizun 2.4: turning at rate (rad/s) about the vertical on an arm of radius (m), the sensor
+     * mounted with roll 20 deg and pitch -10 deg on the arm (so its mean centripetal acceleration
+     * in sensor coordinates is constant, not zero): R = Rz(rate t) R_mount */
+    LEVER_ARM,
+    /* Rizun 2.5 (Fig. 3): harmonic motion along an incline of incline_deg, sensor x up the slope, no
+     * rotation; acceleration peak_acc_g (1) g sin(2 pi frequency (Hz) t) along the incline */
+    INCLINE,
+    /* Luinge's coning, half-angle theta (rad) at rate (rad/s), fixed in position:
+     * R = Rz(rate t) Rx(theta) Rz(-rate t) */
+    CONING,
+    /* Tseng 1-2: pitch amplitude_deg sin(2 pi frequency (Hz) t) about the platform's y, the IMU
+     * inclined by inclination_deg about its x: R = Ry(pitch) Rx(inclination) */
+    SINE_ROTATION,
+    /* Tseng 3: pitch steps of STEP_SIZES_DEG (closed_form.c), each held hold (s) and back to 0 for
+     * hold, each step a raised-cosine ramp (s); repeated after the last */
+    STEP_ROTATION,
+    /* Tseng 4: back and forth along the earth x, x(t) = amplitude (m) (1 - cos(2 pi t/period (s)))/2,
+     * the IMU mounted rotated by mount_x_deg, mount_y_deg, mount_z_deg about x, the new y, the new z */
+    LINEAR_MOTION,
+    /* Tseng 5: yaw psi = amplitude_deg sin(2 pi frequency (Hz) t) on an arm of radius (m), the IMU
+     * mounted with inclination_deg about x and pitch_deg about y: R = Rz(psi) R_mount, position
+     * radius (cos psi, sin psi, 0) */
+    OFFSET_ROTATION,
     N_CLOSED_FORMS
 } ClosedFormProfile;
 
-/* a profile with its parameters, in the order of the Python Profile's params (above), and gravity
- * (m/s^2) */
+/* the profiles' names, in the order above (profile_table.py's) */
+extern const char *const CLOSED_FORM_NAMES[N_CLOSED_FORMS];
+
+/* a profile with its parameters, in the order of profile_table.py's (above), and gravity (m/s^2) */
 typedef struct {
     ClosedFormProfile profile;
     double p[CLOSED_FORM_MAX_PARAMS];
     double g;
 } ClosedForm;
 
+/* the profile of that name: its number, or -1 */
+int closed_form_profile(const char *name);
 /* the interval (t - h, t]: gyr (rad/s), specific force f (m/s^2, sensor coordinates), quat (at t) */
 void closed_form_at(const ClosedForm *motion, double t, double h, double gyr[3], double f[3], double quat[4]);
+/* the intervals ending at the n times t, each h long: gyr, f (n rows of 3), quat (n rows of 4) */
+void closed_form_run(const ClosedForm *motion, const double *t, size_t n, double h, double *gyr, double *f,
+                     double *quat);
 
 #endif

@@ -1,12 +1,11 @@
-/* human_motion.c: Python twin systems/simulation/motion.py (HumanMotion, _human_step, HumanStream);
- * the same operations in the same order. */
-#include "sim/human_motion.h"
+/* human_motion.c: HumanMotion's exact steps. */
+#include "human_motion.h"
 
 #include <math.h>
 
 #include "messages.h"
 #include "quaternion.h"
-#include "sim/noise.h"
+#include "noise.h"
 
 int human_check(const HumanParams *p, char *message, size_t size) {
     const char *names[4] = {"delta_v", "omega_c", "rot_cutoff", "g"};
@@ -55,6 +54,11 @@ void human_step(double state[HUMAN_N_STATES], const double noise[6], const doubl
     out[3] = f.x, out[4] = f.y, out[5] = f.z;
     out[6] = q.w, out[7] = q.x, out[8] = q.y, out[9] = q.z;
     state[6] = q.w, state[7] = q.x, state[8] = q.y, state[9] = q.z;
+}
+
+void human_run(double state[HUMAN_N_STATES], const double *noise, size_t n, const double coef[HUMAN_N_COEF],
+               double *out) {
+    for (size_t k = 0; k < n; k++) human_step(state, noise + 6 * k, coef, out + HUMAN_N_OUT * k);
 }
 
 void human_stream_init(HumanStream *stream, const HumanParams *params, uint64_t seed) {

@@ -1,7 +1,7 @@
 /* human_motion.h: HumanMotion, band-limited human motion (Rizun eq. 14) with a band-limited random
  * rotation: velocity and angular rate are first-order low-passed white noise (exact
- * Ornstein-Uhlenbeck steps), the orientation their integral.
- * Python twin: systems/simulation/motion.py (HumanMotion, _human_step, HumanStream). */
+ * Ornstein-Uhlenbeck steps), the orientation their integral. Bound into Python by
+ * systems/simulation/motion.py (HumanMotion, HumanStream). */
 #ifndef SIM_HUMAN_MOTION_H
 #define SIM_HUMAN_MOTION_H
 
@@ -20,15 +20,18 @@ typedef struct {
 
 /* HumanMotion's refusals: 0, or -1 with the message. */
 int human_check(const HumanParams *p, char *message, size_t size);
-/* the coefficients of the exact steps at sample rate fs (Hz) (HumanMotion.coefficients) */
+/* the coefficients of the exact steps at sample rate fs (Hz) */
 void human_coefficients(const HumanParams *p, double fs, double coef[HUMAN_N_COEF]);
-/* at rest, level (HumanMotion.initial_state) */
+/* at rest, level */
 void human_initial_state(double state[HUMAN_N_STATES]);
-/* one sample from 6 unit normals (_human_step) */
+/* one sample from 6 unit normals */
 void human_step(double state[HUMAN_N_STATES], const double noise[6], const double coef[HUMAN_N_COEF],
                 double out[HUMAN_N_OUT]);
+/* n samples from n rows of 6 unit normals: out n rows of HUMAN_N_OUT, row-major */
+void human_run(double state[HUMAN_N_STATES], const double *noise, size_t n, const double coef[HUMAN_N_COEF],
+               double *out);
 
-/* HumanMotion sample by sample from a seed (HumanStream): plain data. */
+/* HumanMotion sample by sample from a seed: plain data. */
 typedef struct {
     HumanParams params;
     uint64_t seed, k; /* the noise stream MOTION's seed, and the samples drawn */

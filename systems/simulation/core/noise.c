@@ -1,8 +1,8 @@
-/* noise.c: Philox4x64-10 and the Box-Muller transform, the simulations' one random generator.
- * Python twin: systems/simulation/noise.py (check_seed, philox4x64, _box_muller, _fill). */
-#include "sim/noise.h"
+/* noise.c: Philox4x64-10 and the Box-Muller transform, the simulations' one random generator. */
+#include "noise.h"
 
 #include <math.h>
+#include <stdio.h>
 
 #include "messages.h"
 
@@ -15,7 +15,7 @@
 #define UNIT 0x1p-52
 #define TWO_PI 6.283185307179586 /* 2.0 * math.pi */
 
-/* high and low 64-bit words of the 128-bit product a*b (Python: _mulhilo) */
+/* high and low 64-bit words of the 128-bit product a*b */
 static uint64_t mulhilo(uint64_t a, uint64_t b, uint64_t *low) {
     uint64_t a_lo = a & LOW32, a_hi = a >> 32, b_lo = b & LOW32, b_hi = b >> 32;
     uint64_t lo_lo = a_lo * b_lo, hi_lo = a_hi * b_lo, lo_hi = a_lo * b_hi;
@@ -24,8 +24,16 @@ static uint64_t mulhilo(uint64_t a, uint64_t b, uint64_t *low) {
     return a_hi * b_hi + (hi_lo >> 32) + (cross >> 32);
 }
 
+int refuse_seed(const char *repr, char *message, size_t size) {
+    return refuse(message, size, "seed must be a whole number in [0, 2**64), got %s", repr);
+}
+
 int check_seed(long long value, uint64_t *seed, char *message, size_t size) {
-    if (value < 0) return refuse(message, size, "seed must be a whole number in [0, 2**64), got %lld", value);
+    if (value < 0) {
+        char repr[24];
+        snprintf(repr, sizeof repr, "%lld", value);
+        return refuse_seed(repr, message, size);
+    }
     *seed = (uint64_t)value;
     return 0;
 }
@@ -52,15 +60,19 @@ static void box_muller(uint64_t word0, uint64_t word1, double z[2]) {
     z[1] = r * sin(angle);
 }
 
-void noise_normals(uint64_t seed, uint64_t stream, uint64_t k, int width, double *out) {
+void noise_normals(uint64_t seed, uint64_t stream, uint64_t k, size_t width, double *out) {
     const uint64_t key[2] = {seed, stream};
-    for (int j = 0; 4 * j < width; j++) {
+    for (size_t j = 0; j < width / 4 + (width % 4 != 0); j++) {
         const uint64_t counter[4] = {k, (uint64_t)j, 0, 0};
         uint64_t w[4];
         double z[4];
         philox4x64(counter, key, w);
         box_muller(w[0], w[1], z);
         box_muller(w[2], w[3], z + 2);
-        for (int lane = 0; lane < 4 && 4 * j + lane < width; lane++) out[4 * j + lane] = z[lane];
+        for (size_t lane = 0; lane < 4 && 4 * j + lane < width; lane++) out[4 * j + lane] = z[lane];
     }
+}
+
+void noise_fill(uint64_t seed, uint64_t stream, uint64_t first, size_t n, size_t width, double *out) {
+    for (size_t row = 0; row < n; row++) noise_normals(seed, stream, first + (uint64_t)row, width, out + row * width);
 }

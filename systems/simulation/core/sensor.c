@@ -1,18 +1,24 @@
-/* sensor.c: Python twin systems/simulation/sensor_model.py (ImuModel.__post_init__, measure,
- * measure_mag); the same operations in the same order. */
-#include "sim/sensor.h"
+/* sensor.c: the IMU sensor model. */
+#include "sensor.h"
 
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 
 #include "messages.h"
 
-/* Python's repr of a tuple of 3 floats, "(1.0, nan, 0.0)" */
-static const char *triple_repr(const double v[3], char out[3 * FLOAT_REPR_SIZE + 8]) {
+#define TRIPLE_REPR_SIZE (3 * FLOAT_REPR_SIZE + 8)
+
+/* a tuple of 3 floats as Python writes it, "(1.0, nan, 0.0)" */
+static const char *triple_repr(const double v[3], char out[TRIPLE_REPR_SIZE]) {
     char a[FLOAT_REPR_SIZE], b[FLOAT_REPR_SIZE], c[FLOAT_REPR_SIZE];
-    snprintf(out, 3 * FLOAT_REPR_SIZE + 8, "(%s, %s, %s)", float_repr(v[0], a), float_repr(v[1], b),
-             float_repr(v[2], c));
+    snprintf(out, TRIPLE_REPR_SIZE, "(%s, %s, %s)", float_repr(v[0], a), float_repr(v[1], b), float_repr(v[2], c));
     return out;
+}
+
+int imu_refuse_vector(const char *name, const char *repr, char *message, size_t size) {
+    const char *shape = strcmp(name, "gyr_scale") == 0 ? "3\u00d73" : "3";
+    return refuse(message, size, "%s must be %s finite numbers, got %s", name, shape, repr);
 }
 
 int imu_check(const ImuParams *p, char *message, size_t size) {
@@ -25,16 +31,16 @@ int imu_check(const ImuParams *p, char *message, size_t size) {
                           float_repr(values[i], repr));
     const char *vectors[3] = {"gyr_offset", "acc_offset", "mag_offset"};
     const double *components[3] = {p->gyr_offset, p->acc_offset, p->mag_offset};
-    char tuple[3][3 * FLOAT_REPR_SIZE + 8];
+    char tuple[3][TRIPLE_REPR_SIZE], matrix[3 * TRIPLE_REPR_SIZE + 8];
     for (int i = 0; i < 3; i++)
         if (!(isfinite(components[i][0]) && isfinite(components[i][1]) && isfinite(components[i][2])))
-            return refuse(message, size, "%s must be 3 finite numbers, got %s", vectors[i],
-                          triple_repr(components[i], tuple[0]));
+            return imu_refuse_vector(vectors[i], triple_repr(components[i], tuple[0]), message, size);
     for (int c = 0; c < 9; c++)
-        if (!isfinite(p->gyr_scale[c]))
-            return refuse(message, size, "gyr_scale must be 3\u00d73 finite numbers, got (%s, %s, %s)",
-                          triple_repr(p->gyr_scale, tuple[0]), triple_repr(p->gyr_scale + 3, tuple[1]),
-                          triple_repr(p->gyr_scale + 6, tuple[2]));
+        if (!isfinite(p->gyr_scale[c])) {
+            snprintf(matrix, sizeof matrix, "(%s, %s, %s)", triple_repr(p->gyr_scale, tuple[0]),
+                     triple_repr(p->gyr_scale + 3, tuple[1]), triple_repr(p->gyr_scale + 6, tuple[2]));
+            return imu_refuse_vector("gyr_scale", matrix, message, size);
+        }
     return 0;
 }
 
@@ -52,4 +58,14 @@ void imu_measure(const ImuParams *p, const double omega[3], const double f[3], c
 void imu_measure_mag(const ImuParams *p, const double m[3], const double noise[3], double fs, double mag[3]) {
     double scale = p->mag_noise * sqrt(fs / 2.0);
     for (int i = 0; i < 3; i++) mag[i] = m[i] + scale * noise[i] + p->mag_offset[i];
+}
+
+void imu_measure_run(const ImuParams *p, const double *omega, const double *f, const double *noise, size_t n,
+                     double fs, double *gyr, double *acc) {
+    for (size_t k = 0; k < n; k++)
+        imu_measure(p, omega + 3 * k, f + 3 * k, noise + 6 * k, fs, gyr + 3 * k, acc + 3 * k);
+}
+
+void imu_measure_mag_run(const ImuParams *p, const double *m, const double *noise, size_t n, double fs, double *mag) {
+    for (size_t k = 0; k < n; k++) imu_measure_mag(p, m + 3 * k, noise + 3 * k, fs, mag + 3 * k);
 }

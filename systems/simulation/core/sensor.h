@@ -1,7 +1,7 @@
 /* sensor.h: the IMU sensor model, ideal motion signals in, measured signals out (Rizun eqs. 1-2):
  * gyro y_g = (I + S) omega + n + b, accelerometer y_a = f + n_a + acc_offset, magnetometer
  * y_m = m + n_m + mag_offset; white noise of one-sided densities, per-sample s.d. density*sqrt(fs/2).
- * Python twin: systems/simulation/sensor_model.py (ImuModel: __post_init__, measure, measure_mag). */
+ * Bound into Python by systems/simulation/sensor_model.py (ImuModel). */
 #ifndef SIM_SENSOR_H
 #define SIM_SENSOR_H
 
@@ -17,11 +17,19 @@ typedef struct {
 
 /* ImuModel's refusals: 0, or -1 with the message. */
 int imu_check(const ImuParams *p, char *message, size_t size);
+/* the refusal of a vector parameter (gyr_offset, acc_offset, mag_offset: 3 numbers; gyr_scale: 3x3)
+ * that is not all finite numbers of its shape, its value written as repr: -1 with the message */
+int imu_refuse_vector(const char *name, const char *repr, char *message, size_t size);
 /* measured gyr (rad/s) and acc (m/s^2) from the true rate omega, specific force f and 6 unit normals
  * (gyro, then accelerometer) at sample rate fs (Hz) */
 void imu_measure(const ImuParams *p, const double omega[3], const double f[3], const double noise[6], double fs,
                  double gyr[3], double acc[3]);
 /* measured field (uT) from the true field m (uT, sensor coordinates) and 3 unit normals */
 void imu_measure_mag(const ImuParams *p, const double m[3], const double noise[3], double fs, double mag[3]);
+/* n samples of imu_measure: omega, f, gyr, acc n rows of 3, noise n rows of 6 */
+void imu_measure_run(const ImuParams *p, const double *omega, const double *f, const double *noise, size_t n,
+                     double fs, double *gyr, double *acc);
+/* n samples of imu_measure_mag: m, noise, mag n rows of 3 */
+void imu_measure_mag_run(const ImuParams *p, const double *m, const double *noise, size_t n, double fs, double *mag);
 
 #endif

@@ -1,0 +1,81 @@
+/* offline.c: the offline smoother (see offline.h). */
+#include "pipeline/offline.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "quaternion.h"
+
+/* the gyro sample that turns the frame from sample n - k to n - 1 - k in a pass backward in time, k = 0 ... n - 1:
+ * -gyr[n - k] (0 for k = 0, before the first step) */
+static void time_reversed_sample(size_t n, const double *gyr, size_t k, double out[3])
+{
+    for (int i = 0; i < 3; i++)
+        out[i] = k == 0 ? 0.0 : -gyr[3 * (n - k) + i];
+}
+
+/* q (sensor -> earth) turned by the smallest earth-frame rotation that takes the estimated up (gravity, sensor
+ * coordinates) onto earth up: its heading kept */
+static void level_onto(const double q[4], const double gravity[3], double out[4])
+{
+    Quat rot = quat_normalized(quat_load(q));
+    double norm = sqrt(gravity[0] * gravity[0] + gravity[1] * gravity[1] + gravity[2] * gravity[2]);
+    Vec3 up = quat_rotate(rot, (Vec3){gravity[0] / norm, gravity[1] / norm, gravity[2] / norm});
+    double horizontal = hypot(up.x, up.y);
+    double angle = atan2(horizontal, up.z);
+    double scale = horizontal > 0.0 ? angle / horizontal : 0.0;
+    quat_store(quat_normalized(quat_multiply(rotvec_quat(up.y * scale, -up.x * scale, 0.0), rot)), out);
+}
+
+/* One pass of the stepper over n samples, forward (the rows as given) or backward in time (row k
+ * of the pass is row n - 1 - k, turned by time_reversed_sample), from rest on start; the pass's
+ * row k of the estimate into gravity and quat at row n - 1 - k when backward (each row of acc is
+ * read before it is written, so acc may be gravity). wiener's local densities: at the break
+ * frequencies omega (rows as the pass's, NULL: the local ones), and where used is not NULL the
+ * ones used into it (rows as the pass's). */
+static void pass(const AfStepper *s, size_t n, const double *gyr, const double *acc, int backward,
+                 const double start[3], const double *omega, double *used, double *gravity, double *quat)
+{
+    double state[AF_STEPPER_STATE_MAX], g[3], q[4];
+    stepper_initial_state(s, start, state);
+    for (size_t k = 0; k < n; k++) {
+        size_t row = backward ? n - 1 - k : k;
+        double turn[3];
+        if (backward)
+            time_reversed_sample(n, gyr, k, turn);
+        else
+            memcpy(turn, gyr + 3 * k, sizeof turn);
+        if (s->kernel == KERNEL_WIENER_LOCAL) {
+            wiener_local_rows((WienerLocalState *)(void *)state, &s->coef.wiener_local, 1, turn, acc + 3 * row,
+                              omega != NULL ? omega + row : NULL, g, q, used != NULL ? used + row : NULL);
+        } else {
+            stepper_run(s, state, turn, acc + 3 * row, g, q);
+        }
+        memcpy(gravity + 3 * row, g, sizeof g);
+        if (quat != NULL)
+            memcpy(quat + 4 * row, q, sizeof q);
+    }
+}
+
+void offline_smooth(const AfStepper *stepper, size_t n, const double *gyr, const double *acc,
+                    const double initial_gravity[3], double *gravity, double *quat, double *omega)
+{
+    const double *imposed = NULL;
+    double last[3];
+    if (stepper->kernel == KERNEL_WIENER_LOCAL) {
+        /* the break frequencies of the local densities forward, then the lower of those and the
+         * backward ones; gravity and quat serve as scratch meanwhile */
+        double *backward = quat; /* n values at least (n x 4) */
+        pass(stepper, n, gyr, acc, 0, initial_gravity, NULL, omega, gravity, NULL);
+        memcpy(last, acc + 3 * (n - 1), sizeof last);
+        pass(stepper, n, gyr, acc, 1, last, NULL, backward, gravity, NULL);
+        for (size_t k = 0; k < n; k++)
+            omega[k] = fmin(omega[k], backward[k]);
+        imposed = omega;
+    }
+    pass(stepper, n, gyr, acc, 0, initial_gravity, imposed, NULL, gravity, quat);
+    memcpy(last, gravity + 3 * (n - 1), sizeof last);
+    pass(stepper, n, gyr, gravity, 1, last, imposed, NULL, gravity, NULL);
+    for (size_t k = 0; k < n; k++)
+        level_onto(quat + 4 * k, gravity + 3 * k, quat + 4 * k);
+}

@@ -1,0 +1,219 @@
+"""The generated files of a native FMU, written by the build (CMakeLists.txt, af_fmu) into the
+FMU's staging folder, beside its sources:
+
+    python fmu_src/generate.py NAME FMI STAGE VERSION DEST=SOURCE...
+
+NAME is a model of MODELS (its C model file, NAME.c in fmu_src/models), FMI "2.0" or "3.0",
+VERSION the project's (the generation tool's), each DEST=SOURCE a source file and its path
+under the FMU's sources/ folder (as the files include each other: that folder is the one
+include directory, as `fmpy compile` builds it). Writes into STAGE:
+
+    modelDescription.xml              from the table of FMU variables (fmu_src/variables.py)
+    sources/DEST...                   the sources, copied
+    sources/NAME_variables.h          the variables as the plumbing takes them (fmi2/fmi2_model.h)
+    sources/buildDescription.xml      every C file, for importers that build the FMU themselves
+
+The guid (FMI 3.0: instantiation token) is a digest of the sources, the variables and the
+description, so an FMU built from other sources is told apart (systems.fmi.native.is_current).
+Only the standard library is needed: the package's folder is loaded as attitude_fmu without
+its dependencies.
+"""
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+import sys
+import uuid
+from dataclasses import dataclass
+from pathlib import Path
+from xml.etree.ElementTree import Element, SubElement, tostring
+
+if __package__ in (None, ""):  # run as a script by the build: this clone's folder as attitude_fmu
+    _root = Path(__file__).resolve().parents[1]
+    _spec = importlib.util.spec_from_file_location("attitude_fmu", _root / "__init__.py",
+                                                   submodule_search_locations=[str(_root)])
+    sys.modules["attitude_fmu"] = importlib.util.module_from_spec(_spec)
+    _spec.loader.exec_module(sys.modules["attitude_fmu"])
+
+from attitude_fmu.blocks.core.generate_tables import c_double, c_string  # noqa: E402
+from attitude_fmu.fmu_src.model_description import (  # noqa: E402
+    LOG_CATEGORIES,
+    model_description,
+    model_description3,
+    model_variables,
+    model_variables3,
+)
+from attitude_fmu.fmu_src.simulation_variables import imu_sensor, motion_profile  # noqa: E402
+from attitude_fmu.fmu_src.variables import BOOLEAN, INTEGER, OUT, PAR, REAL, STRING, attitude_estimator  # noqa: E402
+
+GUID_NAMESPACE = uuid.UUID("6f0e2a4c-8b1d-4c55-9d3e-2f7a1b9c0d41")  # of the native FMUs' guids
+
+
+@dataclass(frozen=True)
+class NativeModel:
+    """A native FMU's interface (a table of fmu_src.variables) and description."""
+
+    interface: object
+    description: str
+
+
+MODELS = {
+    "AttitudeEstimator": NativeModel(attitude_estimator, "IMU attitude estimator (Rizun's optimal Wiener filter and "
+                                     "peers); gravity up, ENU, q sensor->earth; in C, no Python"),
+    "NoOpEstimator": NativeModel(attitude_estimator, "AttitudeEstimator's interface; doStep does nothing "
+                                 "(benchmark baseline)"),
+    "ImuSensor": NativeModel(imu_sensor, "IMU sensor model: gyro noise density, offset, scale and misalignment, "
+                             "accelerometer noise and offset, magnetometer noise and hard iron; in C, no Python"),
+    "MotionProfile": NativeModel(motion_profile, "Motion profiles with exact truth: ideal gyro, specific force, "
+                                 "magnetic field, orientation; in C, no Python"),
+}
+
+
+def _initial(v) -> str:
+    """The variable's initial in C, as FMI 2.0 defaults it where the table states none."""
+    if v.initial is not None:
+        return f"FMI2_{v.initial.upper()}"
+    if v.causality == PAR:
+        return "FMI2_EXACT"
+    return "FMI2_CALCULATED" if v.causality == OUT else "FMI2_INITIAL_UNSET"
+
+
+def _identifier(name: str) -> str:
+    if not (name.isidentifier() and name.isascii()):
+        raise ValueError(f"variable name {name!r} is not a C identifier")
+    return name
+
+
+def variables_header(name: str, guid: str) -> str:
+    """The text of <name>_variables.h: the model's variables as the plumbing takes them
+    (fmi2/fmi2_model.h: Fmi2Variable, by value reference) and the index of each among those
+    of its type (REAL_<variable>, INTEGER_…, BOOLEAN_…, STRING_…), which the model file uses."""
+    variables = MODELS[name].interface()
+    if [v.value_reference for v in variables] != list(range(len(variables))):
+        raise ValueError(f"{name}: the plumbing needs value references 0, 1, 2, … in the table's order")
+    if len(LOG_CATEGORIES) > 32:
+        raise ValueError("more log categories than fmi2/fmi2_model.h's FMI2_MAX_CATEGORIES")
+    lines = []
+    for type_ in (REAL, INTEGER, BOOLEAN, STRING):
+        names = [_identifier(v.name) for v in variables if v.type == type_]
+        if names:
+            lines += ["enum {", *(f"    {type_.upper()}_{n} = {i}," for i, n in enumerate(names)), "};"]
+        lines.append(f"#define N_{type_.upper()}S {len(names)}")
+    rows = []
+    for v in variables:
+        start = ("0.0", c_string(v.start)) if v.type == STRING else (c_double(float(v.start)), "NULL")
+        rows.append(f"    {{{c_string(v.name)}, FMI2_{v.type.upper()}, FMI2_{v.causality.upper()}, "
+                    f"FMI2_{v.variability.upper()}, {_initial(v)}, {v.type.upper()}_{v.name}, {start[0]}, {start[1]}}},"
+                    f" /* {v.value_reference} */")
+    guard = f"{name.upper()}_VARIABLES_H"
+    return "\n".join([
+        f"/* {name}_variables.h: the variables of {name}.fmu, generated by fmu_src/generate.py from the",
+        " * table of FMU variables (fmu_src/variables.py) that writes its modelDescription.xml.",
+        " * Do not edit: generate it again. */",
+        f"#ifndef {guard}",
+        f"#define {guard}",
+        "",
+        "#include <math.h> /* NAN */",
+        "",
+        '#include "fmi2/fmi2_model.h"',
+        "",
+        f"#define MODEL_IDENTIFIER {c_string(name)}",
+        f"#define MODEL_GUID {c_string(guid)}",
+        "",
+        "/* the index of each variable among those of its type */",
+        *lines,
+        "",
+        f"#define N_VARIABLES {len(variables)}",
+        "/* by value reference */",
+        "static const Fmi2Variable MODEL_VARIABLES[N_VARIABLES] = {",
+        *rows,
+        "};",
+        "",
+        f"#define N_LOG_CATEGORIES {len(LOG_CATEGORIES)}",
+        "static const char *const MODEL_LOG_CATEGORIES[N_LOG_CATEGORIES] = {",
+        *(f"    {c_string(c)}," for c in LOG_CATEGORIES),
+        "};",
+        "",
+        "#endif",
+        "",
+    ])
+
+
+def guid(name: str, fmi: str, sources: dict[str, bytes]) -> str:
+    """The FMU's guid (FMI 3.0: instantiation token): a digest of its sources (path under
+    sources/ → contents; the generated variables header aside), its variables and its description."""
+    model = MODELS[name]
+    digest = hashlib.sha256(b"fmi3" if fmi == "3.0" else b"")
+    for path, data in sorted(sources.items()):
+        digest.update(f"{path}\0{len(data)}\0".encode())
+        digest.update(data)
+    variables = (model_variables3 if fmi == "3.0" else model_variables)(model.interface())
+    digest.update(tostring(variables))
+    digest.update(model.description.encode())
+    return "{" + str(uuid.uuid5(GUID_NAMESPACE, digest.hexdigest())) + "}"
+
+
+def build_description(name: str, fmi: str, c_files) -> bytes:
+    """sources/buildDescription.xml (FMI 3.0's format, which fmpy reads for FMI 2.0 FMUs too)."""
+    headers = "fmi3Functions.h" if fmi == "3.0" else "fmi2Functions.h"
+    root = Element("fmiBuildDescription", fmiVersion="3.0")
+    config = SubElement(root, "BuildConfiguration", modelIdentifier=name,
+                        description=f"a shared library of every C file listed; C99, with the FMI {fmi} headers "
+                                    f"({headers}) and this folder on the include path")
+    files = SubElement(config, "SourceFileSet", language="C99")
+    for path in c_files:
+        SubElement(files, "SourceFile", name=path)
+    SubElement(files, "IncludeDirectory", name=".")
+    SubElement(config, "Library", name="m", external="true",
+               description="the C math library (link with -lm where it is apart from the C library)")
+    return tostring(root, xml_declaration=True, encoding="UTF-8")
+
+
+def generated_files(name: str, fmi: str, version: str, sources: dict[str, bytes]) -> dict[str, bytes]:
+    """The FMU's files by their path in it but its binary: modelDescription.xml and sources/ (the
+    given sources, the variables header, buildDescription.xml)."""
+    if fmi not in ("2.0", "3.0"):
+        raise ValueError(f"FMI version {fmi!r}: 2.0 or 3.0")
+    model, token = MODELS[name], guid(name, fmi, sources)
+    files = {**sources, f"{name}_variables.h": variables_header(name, token).encode("ascii")}
+    c_files = sorted(p for p in files if p.endswith(".c"))
+    tool = f"attitude-fmu {version}"
+    if fmi == "3.0":
+        md = model_description3(name, model.description, token, model.interface(), tool)
+    else:
+        md = model_description(name, model.description, token, model.interface(), tool, c_files)
+    files["buildDescription.xml"] = build_description(name, fmi, c_files)
+    return {"modelDescription.xml": tostring(md, xml_declaration=True, encoding="UTF-8"),
+            **{f"sources/{path}": data for path, data in files.items()}}
+
+
+def write_stage(stage, files: dict[str, bytes]) -> None:
+    """files (path → contents) written into the folder stage; its sources/ keeps no other file."""
+    stage = Path(stage)
+    old = stage / "sources"
+    if old.is_dir():
+        for path in sorted(old.rglob("*"), reverse=True):  # files before their folders
+            if path.is_file() and path.relative_to(stage).as_posix() not in files:
+                path.unlink()
+            elif path.is_dir() and not any(path.iterdir()):
+                path.rmdir()
+    for path, data in files.items():
+        target = stage / path
+        target.parent.mkdir(parents=True, exist_ok=True)
+        target.write_bytes(data)
+
+
+def main(argv) -> int:
+    if len(argv) < 5 or argv[0] not in MODELS:
+        sys.exit(__doc__)
+    name, fmi, stage, version, *pairs = argv
+    sources = {}
+    for pair in pairs:
+        dest, _, source = pair.partition("=")
+        sources[dest] = Path(source).read_bytes()
+    write_stage(stage, generated_files(name, fmi, version, sources))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

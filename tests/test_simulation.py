@@ -1,0 +1,297 @@
+"""The simulation (systems/simulation/core through the public API) against independent truth:
+the noise streams are Box–Muller of numpy's Philox4x64-10 blocks; the closed-form profiles
+are their formulas, evaluated here with scipy's Rotation; the human motion is the exact
+Ornstein–Uhlenbeck recursion of its docstring driven by the stream MOTION; the sensor is
+Rizun's eqs. 1–2 with the streams SENSOR and MAGNETOMETER and a linear-interpolating delay
+line; the noise densities measured over a long run are the parameters; refusals keep their
+words."""
+import math
+
+import numpy as np
+import pytest
+from scipy.signal import welch
+from scipy.spatial.transform import Rotation
+
+from attitude_fmu import HumanMotion, ImuModel, profile
+from attitude_fmu.systems.simulation.motion import PROFILES
+from attitude_fmu.systems.simulation.noise import MAGNETOMETER, MOTION, SENSOR, normals
+from tests.motions import ClosedFormMotion, still
+
+FS = 100.0
+G = 9.79  # m/s², not the default: the profiles take it
+
+
+# ---- the noise streams
+
+def _philox_normals(seed, stream, n, width, first=0):
+    """Normal i of sample k: lane i mod 4 of the Philox4x64-10 block of counter (k, ⌊i/4⌋, 0, 0)
+    under the key (seed, stream), numpy's Philox; lanes (0, 1) and (2, 3) Box–Muller pairs of
+    the uniforms ((word >> 12) + ½)·2⁻⁵²."""
+    key = seed + (stream << 64)
+    blocks = (width + 3) // 4
+    # numpy counts its counter up before each block it draws: counter − 1
+    words = np.array([[np.random.Philox(counter=(k + (j << 64) - 1) % 2**256, key=key).random_raw(4)
+                       for j in range(blocks)] for k in range(first, first + n)]).reshape(n, 4 * blocks)
+    u = ((words >> np.uint64(12)).astype(float) + 0.5) * 2.0**-52
+    r, angle = np.sqrt(-2.0 * np.log(u[:, 0::2])), 2.0 * math.pi * u[:, 1::2]
+    return np.stack([r * np.cos(angle), r * np.sin(angle)], axis=2).reshape(n, 4 * blocks)[:, :width]
+
+
+@pytest.mark.parametrize("seed, stream, width, first", [(0, MOTION, 6, 0), (2**40 + 3, SENSOR, 6, 0),
+                                                        (2**64 - 1, MAGNETOMETER, 3, 0), (7, SENSOR, 6, 10**12),
+                                                        (123456789, MOTION, 9, 2**63)])
+def test_the_normals_are_box_muller_of_numpys_philox(seed, stream, width, first):
+    got = normals(seed, stream, 300, width, first=first)
+    assert np.abs(got - _philox_normals(seed, stream, 300, width, first)).max() < 1e-13
+
+
+def test_a_stream_read_from_a_later_sample_continues_it():
+    whole = normals(5, SENSOR, 400)
+    assert np.array_equal(normals(5, SENSOR, 150, first=250), whole[250:])
+    assert not np.array_equal(normals(6, SENSOR, 400), whole) and not np.array_equal(normals(5, MOTION, 400), whole)
+
+
+def test_the_streams_are_unit_normal_and_independent():
+    z = np.hstack([normals(3, s, 100_000) for s in (MOTION, SENSOR, MAGNETOMETER)])
+    assert np.abs(z.mean(axis=0)).max() < 5 / math.sqrt(len(z))
+    assert np.abs(z.std(axis=0) - 1.0).max() < 0.01
+    assert np.abs(np.corrcoef(z.T) - np.eye(z.shape[1])).max() < 5 / math.sqrt(len(z))
+    assert np.abs(np.corrcoef(z[1:, 0], z[:-1, 0])[0, 1]) < 5 / math.sqrt(len(z))  # from one sample to the next
+    assert np.mean(np.abs(z) > 4.0) == pytest.approx(6.334e-5, rel=0.25)  # the tails: P(|z| > 4)
+
+
+@pytest.mark.parametrize("seed", [-1, 2**64, 1.5, True])
+def test_a_seed_outside_0_to_2_64_is_refused(seed):
+    with pytest.raises(ValueError) as refused:
+        normals(seed, MOTION, 1)
+    assert str(refused.value) == f"seed must be a whole number in [0, 2**64), got {seed!r}"
+
+
+# ---- the closed-form profiles, their formulas in scipy
+
+def _about(axis, angle):
+    """Rotations about a coordinate axis by angle (rad, N)."""
+    angle = np.atleast_1d(np.asarray(angle, dtype=float))
+    vectors = np.zeros((len(angle), 3))
+    vectors[:, "xyz".index(axis)] = angle
+    return Rotation.from_rotvec(vectors)
+
+
+def _fixed(rotation, t):
+    """rotation at every time of t."""
+    return Rotation.from_quat(np.tile(rotation.as_quat(), (len(t), 1)))
+
+
+def _step_pitch(hold, ramp):
+    """Tseng's experiment 3: pitch (rad) of t, steps of 5, 10, 20, 45 and 90° each held hold s
+    and back to 0 for hold s, each a raised-cosine ramp of ramp s, repeating."""
+    levels = np.radians([x for size in (5.0, 10.0, 20.0, 45.0, 90.0) for x in (size, 0.0)])
+
+    def pitch(t):
+        i = np.floor(t / hold).astype(int)
+        into = t - i * hold
+        now, before = levels[i % len(levels)], levels[(i - 1) % len(levels)]
+        blend = np.where(into < ramp, 0.5 - 0.5 * np.cos(np.pi * np.clip(into / ramp, 0, 1)), 1.0)
+        return np.where(t < hold, now * blend, before + (now - before) * blend)
+    return pitch
+
+
+def _yaw_arm(frequency, amplitude_deg, radius, inclination_deg, pitch_deg):
+    """Tseng's experiment 5: yaw ψ = amplitude·sin(2π·f·t) on an arm of radius (m), the sensor
+    mounted inclined about x and pitched about y."""
+    amp, w = math.radians(amplitude_deg), 2 * math.pi * frequency
+    mount = Rotation.from_euler("xy", [inclination_deg, pitch_deg], degrees=True)
+
+    def velocity(t):
+        psi, psi_dot = amp * np.sin(w * t), amp * w * np.cos(w * t)
+        return radius * np.column_stack([-np.sin(psi) * psi_dot, np.cos(psi) * psi_dot, np.zeros_like(t)])
+    return (lambda t: _about("z", amp * np.sin(w * t)) * mount), velocity
+
+
+def _incline(incline_deg, peak_acc_g, frequency, g):
+    """Rizun §2.5: harmonic motion along an incline, peak acceleration peak_acc_g·g, no rotation."""
+    orient = Rotation.from_euler("y", -incline_deg, degrees=True)  # sensor x up the slope
+    w = 2 * math.pi * frequency
+    return (lambda t: _fixed(orient, t)), lambda t: np.outer(-peak_acc_g * g / w * np.cos(w * t),
+                                                             orient.apply([1.0, 0.0, 0.0]))
+
+
+# name → (parameters, g) → (orientation R(t), earth-frame velocity v(t)): the profiles' definitions
+CLOSED_FORMS = {
+    "lever_arm": lambda p, g: (
+        lambda t: _about("z", p["rate"] * t) * Rotation.from_euler("xy", (20.0, -10.0), degrees=True),
+        lambda t: p["rate"] * p["radius"] * np.column_stack([-np.sin(p["rate"] * t), np.cos(p["rate"] * t),
+                                                             np.zeros_like(t)])),
+    "incline": lambda p, g: _incline(p["incline_deg"], p["peak_acc_g"], p["frequency"], g),
+    "coning": lambda p, g: (
+        lambda t: _about("z", p["rate"] * t) * _about("x", np.full(len(t), p["theta"])) * _about("z", -p["rate"] * t),
+        still),
+    "sine_rotation": lambda p, g: (
+        lambda t: _about("y", math.radians(p["amplitude_deg"]) * np.sin(2 * math.pi * p["frequency"] * t))
+        * _about("x", np.full(len(t), math.radians(p["inclination_deg"]))), still),
+    "step_rotation": lambda p, g: ((lambda t: _about("y", _step_pitch(p["hold"], p["ramp"])(t))), still),
+    "linear_motion": lambda p, g: (
+        lambda t: _fixed(Rotation.from_euler("XYZ", [p["mount_x_deg"], p["mount_y_deg"], p["mount_z_deg"]],
+                                             degrees=True), t),
+        lambda t: np.outer(p["amplitude"] * math.pi / p["period"] * np.sin(2 * math.pi / p["period"] * t),
+                           [1.0, 0.0, 0.0])),
+    "offset_rotation": lambda p, g: _yaw_arm(p["frequency"], p["amplitude_deg"], p["radius"], p["inclination_deg"],
+                                             p["pitch_deg"]),
+}
+
+
+def _same_rotations(q, p):
+    """Largest distance of unit quaternions q from p, either sign."""
+    return np.minimum(np.abs(q - p).max(axis=1), np.abs(q + p).max(axis=1)).max()
+
+
+def test_every_profile_but_human_has_its_closed_form_here():
+    assert set(CLOSED_FORMS) == set(PROFILES) - {"human"}
+
+
+@pytest.mark.parametrize("name", sorted(CLOSED_FORMS))
+@pytest.mark.parametrize("changed", [False, True])
+def test_a_closed_form_profile_samples_its_formula(name, changed):
+    """Over (t − h, t]: quat is R(t); gyr the rotation vector of R(t−h)ᵀ·R(t) over h (so
+    integrating it gives R exactly); acc R(t)ᵀ·((v(t) − v(t−h))/h + g·ẑ) (tests/motions.py);
+    60 s (many turns), at its defaults and with every parameter changed, within 1e-12 of each
+    quantity's scale."""
+    params = {p.name: (1.3 * p.default + 0.7 if changed else p.default) for p in PROFILES[name].params}
+    motion = profile(name).motion(params if changed else {}, g=G).generate(60.0, FS)
+    truth = ClosedFormMotion(*CLOSED_FORMS[name](params, G), g=G).generate(60.0, FS)
+    assert len(motion.gyr) == 6000 and np.ptp(motion.gyr, axis=0).max() + np.ptp(motion.acc, axis=0).max() > 0
+    assert _same_rotations(motion.quat, truth.quat) < 1e-12
+    assert np.abs(motion.gyr - truth.gyr).max() < 1e-12 * max(1.0, np.abs(truth.gyr).max())
+    assert np.abs(motion.acc - truth.acc).max() < 1e-12 * max(1.0, np.abs(truth.acc).max())
+
+
+# ---- the human motion: Ornstein–Uhlenbeck steps of the stream MOTION
+
+@pytest.mark.parametrize("motion, seed", [(HumanMotion(), 0), (HumanMotion(0.4, 6.0, 2.5, 9.0, G), 2**33 + 5)])
+def test_the_human_motion_is_the_ou_recursion_of_its_noise_stream(motion, seed):
+    """v_k = φ_v·v_{k−1} + σ_v·z_k[0:3], ω_k = φ_w·ω_{k−1} + σ_w·z_k[3:6] with z the stream MOTION,
+    φ = exp(−ω·Ts), σ_v² = δ_v²·ω_c/4·(1 − φ_v²) (eq. 14's variance), σ_w² = rot_rms²·(1 − φ_w²);
+    the motion starts level and at rest; gyr[k] is ω_k, the rotation of each interval; the
+    velocity is the earth-frame specific force less g, integrated."""
+    n, Ts = 3000, 1.0 / FS
+    run = motion.generate(n / FS, FS, seed)
+    z = normals(seed, MOTION, n)
+    rot = Rotation.from_quat(run.quat, scalar_first=True)
+    steps = Rotation.concatenate([Rotation.identity(), rot[:-1]]).inv() * rot  # from level at rest
+    assert np.abs(steps.as_rotvec() - run.gyr * Ts).max() < 1e-14
+    velocity = np.cumsum(rot.apply(run.acc) - [0.0, 0.0, motion.g], axis=0) * Ts
+    phi_v, phi_w = math.exp(-motion.omega_c * Ts), math.exp(-motion.rot_cutoff * Ts)
+    sigma_v = math.sqrt(motion.delta_v**2 * motion.omega_c / 4.0 * (1.0 - phi_v**2))
+    sigma_w = math.sqrt(motion.rot_rms**2 * (1.0 - phi_w**2))
+    before = np.vstack([np.zeros((1, 3)), velocity[:-1]])
+    assert np.abs((velocity - phi_v * before) / sigma_v - z[:, 0:3]).max() < 1e-9
+    omega_before = np.vstack([np.zeros((1, 3)), run.gyr[:-1]])
+    assert np.abs((run.gyr - phi_w * omega_before) / sigma_w - z[:, 3:6]).max() < 1e-9
+
+
+@pytest.mark.parametrize("values, message", [
+    ({"delta_v": 0.0}, "delta_v must be a finite positive number, got 0.0"),
+    ({"omega_c": math.nan}, "omega_c must be a finite positive number, got nan"),
+    ({"rot_cutoff": -1.0}, "rot_cutoff must be a finite positive number, got -1.0"),
+    ({"g": math.inf}, "g must be a finite positive number, got inf"),
+    ({"rot_rms": -0.5}, "rot_rms must be finite and non-negative, got -0.5"),
+])
+def test_the_human_motion_refuses_bad_parameters_in_its_words(values, message):
+    with pytest.raises(ValueError) as refused:
+        HumanMotion(**{"delta_v": 1.0, "omega_c": 10.0, "rot_rms": 1.0, "rot_cutoff": 5.0, "g": 9.81, **values})
+    assert str(refused.value) == message
+
+
+# ---- the sensor: Rizun's eqs. 1–2, the noise streams, a delay line
+
+SENSOR_ERRORS = dict(delta_n=math.radians(0.1), gyr_offset=(0.01, -0.02, 0.03),
+                     gyr_scale=((0.01, -0.002, 0.0), (0.003, 0.0, 0.005), (0.0, 0.004, -0.02)), acc_noise=0.01,
+                     acc_offset=(0.1, -0.2, 0.3), mag_noise=0.5, mag_offset=(8.0, -3.0, 12.0))
+
+
+def _late(x, samples):
+    """x (N×…) samples·Ts late, linearly between whole samples (x constant within each
+    interval), the first sample before the start."""
+    whole, phase = divmod(samples, 1.0)
+    whole = int(whole)
+    padded = np.vstack([np.repeat(x[:1], whole + 1, axis=0), x])
+    now = padded[1:len(x) + 1]  # x[k − whole]
+    earlier = padded[:len(x)]  # x[k − whole − 1]
+    return (1.0 - phase) * now + phase * earlier
+
+
+@pytest.mark.parametrize("latency", [0.0, 0.02, 0.0234, 0.05])
+def test_the_sensor_measures_eqs_1_2_with_its_noise_streams_through_its_delay_line(latency):
+    """gyr = (I + S)·ω + δ_n·√(fs/2)·z[0:3] + b, acc = f + σ_a·√(fs/2)·z[3:6] + b_a with z the
+    stream SENSOR, ω and f latency late (between samples: linear between the two it falls
+    between); mag = m + σ_m·√(fs/2)·z_m + b_m with z_m the stream MAGNETOMETER (no delay)."""
+    imu = ImuModel(**SENSOR_ERRORS, latency=latency)
+    motion = HumanMotion().generate(20.0, FS, seed=3)
+    gyr, acc = imu.apply(motion, seed=4)
+    mag = imu.apply_mag(motion, seed=4)
+    z, z_mag, scale = normals(4, SENSOR, len(gyr)), normals(4, MAGNETOMETER, len(gyr)), math.sqrt(FS / 2.0)
+    omega, f = _late(motion.gyr, latency * FS), _late(motion.acc, latency * FS)
+    S = np.array(SENSOR_ERRORS["gyr_scale"])
+    expected_gyr = omega + omega @ S.T + SENSOR_ERRORS["delta_n"] * scale * z[:, 0:3] + SENSOR_ERRORS["gyr_offset"]
+    expected_acc = f + SENSOR_ERRORS["acc_noise"] * scale * z[:, 3:6] + SENSOR_ERRORS["acc_offset"]
+    expected_mag = motion.mag + SENSOR_ERRORS["mag_noise"] * scale * z_mag + SENSOR_ERRORS["mag_offset"]
+    assert np.abs(gyr - expected_gyr).max() < 1e-12 * np.abs(expected_gyr).max()
+    assert np.abs(acc - expected_acc).max() < 1e-12 * np.abs(expected_acc).max()
+    assert np.abs(mag - expected_mag).max() < 1e-12 * np.abs(expected_mag).max()
+
+
+def test_a_sensor_a_whole_number_of_samples_late_shifts_the_motion_exactly():
+    motion = profile("sine_rotation").motion({"inclination_deg": 20.0}).generate(10.0, FS)
+    gyr, acc = ImuModel(latency=3.0 / FS).apply(motion)
+    assert (gyr[3:] == motion.gyr[:-3]).all() and (acc[3:] == motion.acc[:-3]).all()
+    assert (gyr[:3] == motion.gyr[0]).all()  # before the start: the first sample
+
+
+@pytest.mark.parametrize("values, message", [
+    ({"delta_n": -1.0}, "delta_n must be finite and non-negative, got -1.0"),
+    ({"acc_noise": math.nan}, "acc_noise must be finite and non-negative, got nan"),
+    ({"latency": math.inf}, "latency must be finite and non-negative, got inf"),
+    ({"mag_noise": -0.1}, "mag_noise must be finite and non-negative, got -0.1"),
+    ({"gyr_offset": (0.0, math.nan, 0.0)}, "gyr_offset must be 3 finite numbers, got (0.0, nan, 0.0)"),
+    ({"acc_offset": (math.inf, 0.0, 0.0)}, "acc_offset must be 3 finite numbers, got (inf, 0.0, 0.0)"),
+    ({"mag_offset": (0.0, 0.0, -math.inf)}, "mag_offset must be 3 finite numbers, got (0.0, 0.0, -inf)"),
+    ({"gyr_scale": ((0.0, 0.0, 0.0), (0.0, 0.0, math.nan), (0.0, 0.0, 0.0))},
+     "gyr_scale must be 3×3 finite numbers, got ((0.0, 0.0, 0.0), (0.0, 0.0, nan), (0.0, 0.0, 0.0))"),
+    ({"gyr_scale": ((0.0, 0.0), (0.0, 0.0))}, "gyr_scale must be 3×3 finite numbers, got ((0.0, 0.0), (0.0, 0.0))"),
+])
+def test_the_sensor_refuses_bad_parameters_in_its_words(values, message):
+    with pytest.raises(ValueError) as refused:
+        ImuModel(**values)
+    assert str(refused.value) == message
+
+
+def test_a_latency_longer_than_the_delay_line_is_refused():
+    """The delay line holds 1021 samples: 10.2 s at 100 Hz fits, 11 s does not (the native
+    sensor FMU refuses it alike: tests/test_native_chain.py)."""
+    motion = HumanMotion().generate(1.0, FS, seed=1)
+    assert ImuModel(latency=10.2).apply(motion)[0].shape == (100, 3)
+    with pytest.raises(ValueError) as refused:
+        ImuModel(latency=11.0).apply(motion)
+    assert str(refused.value) == "latency 11.0 s at 100.0 Hz is longer than the delay line's 1021 samples"
+
+
+def _density(x, fs):
+    """The one-sided noise density (unit/√Hz) of each column of x: Welch's estimate averaged
+    over the band, DC and Nyquist left out."""
+    _, psd = welch(x, fs, nperseg=256, axis=0)
+    return np.sqrt(psd[1:-1].mean(axis=0))
+
+
+def test_the_noise_densities_measured_over_a_long_run_are_the_parameters():
+    """500 s at 100 Hz at rest: the measured error's density is delta_n, acc_noise and
+    mag_noise within 3 % (Welch's estimate scatters by about 0.3 % here; a per-sample s.d.
+    of density·√fs instead of density·√(fs/2) is 41 % off), its mean the offset."""
+    imu = ImuModel(delta_n=math.radians(0.1), acc_noise=0.02, mag_noise=0.3, gyr_offset=(0.01, 0.0, 0.0),
+                   mag_offset=(5.0, 0.0, -2.0))
+    motion = HumanMotion(delta_v=1e-12, rot_rms=0.0).generate(500.0, FS, seed=1)
+    gyr, acc = imu.apply(motion, seed=9)
+    errors = (gyr - motion.gyr, acc - motion.acc, imu.apply_mag(motion, seed=9) - motion.mag)
+    for error, density, offset in zip(errors, (imu.delta_n, imu.acc_noise, imu.mag_noise),
+                                      (imu.gyr_offset, imu.acc_offset, imu.mag_offset)):
+        assert _density(error - error.mean(axis=0), FS) == pytest.approx(np.full(3, density), rel=0.03)
+        assert error.mean(axis=0) == pytest.approx(offset, abs=4 * density * math.sqrt(FS / 2) / math.sqrt(len(error)))
