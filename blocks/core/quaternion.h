@@ -38,9 +38,12 @@ static inline Quat rotvec_quat(double rx, double ry, double rz)
     double angle2 = rx * rx + ry * ry + rz * rz;
     double c, s;
     if (angle2 < SERIES_ANGLE2) {
-        /* cos(theta/2) and sin(theta/2)/theta by their Taylor series */
-        c = 1.0 - angle2 / 8.0 * (1.0 - angle2 / 48.0 * (1.0 - angle2 / 120.0 * (1.0 - angle2 / 224.0)));
-        s = 0.5 * (1.0 - angle2 / 24.0 * (1.0 - angle2 / 80.0 * (1.0 - angle2 / 168.0 * (1.0 - angle2 / 288.0))));
+        /* cos(theta/2) and sin(theta/2)/theta by their Taylor series, the divisions by the terms'
+         * ratios (8, 48, 120, 224; 24, 80, 168, 288) as products with their reciprocals */
+        c = 1.0 - angle2 * 0.125 * (1.0 - angle2 * (1.0 / 48.0) * (1.0 - angle2 * (1.0 / 120.0) *
+                                                                   (1.0 - angle2 * (1.0 / 224.0))));
+        s = 0.5 * (1.0 - angle2 * (1.0 / 24.0) * (1.0 - angle2 * (1.0 / 80.0) * (1.0 - angle2 * (1.0 / 168.0) *
+                                                                                 (1.0 - angle2 * (1.0 / 288.0)))));
     } else {
         double angle = sqrt(angle2);
         c = cos(0.5 * angle);
