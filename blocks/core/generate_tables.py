@@ -47,7 +47,7 @@ def stages() -> list[tuple[str, str, str, tuple[Param, ...]]]:
     gyro-offset and heading estimators."""
     if len(ESTIMATORS) != len(ESTIMATOR_STAGES):
         raise ValueError(f"blocks.pipeline.causal.ESTIMATORS has {len(ESTIMATORS)} stages; "
-                         f"native_tables.ESTIMATOR_STAGES names {len(ESTIMATOR_STAGES)}")
+                         f"generate_tables.ESTIMATOR_STAGES names {len(ESTIMATOR_STAGES)}")
     methods = [(name, f"method {name!r}", f"the method {name}", params) for name, (_, params) in METHODS.items()]
     return methods + [(name, label, label, params) for name, (label, params) in zip(ESTIMATOR_STAGES, ESTIMATORS.items())]
 
@@ -140,7 +140,7 @@ def _param_fields() -> list[CField]:
         sequence = len(kinds) == 1 and TUPLE.fullmatch(kinds[0])
         element = sequence.group(1) if sequence else kinds[0] if len(kinds) == 1 else None
         if element not in C_TYPES:
-            raise ValueError(f"Param.{field.name}: no C type for {type_name!r} (native_tables.C_TYPES, "
+            raise ValueError(f"Param.{field.name}: no C type for {type_name!r} (generate_tables.C_TYPES, "
                              "tuple[T, ...] of one, either | None)")
         c_name = field.name + "_value" if field.name in C_KEYWORDS else field.name
         fields.append(CField(field.name, c_name, element, bool(sequence), optional))
