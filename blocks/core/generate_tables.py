@@ -27,8 +27,7 @@ if __package__ in (None, ""):  # run as a script by the build: this clone's fold
     _spec.loader.exec_module(sys.modules["attitude_fmu"])
 
 from attitude_fmu.blocks.params import Param  # noqa: E402
-from attitude_fmu.blocks.tuning import ESTIMATORS, METHODS  # noqa: E402
-from attitude_fmu.blocks.tuning import uses  # noqa: E402
+from attitude_fmu.blocks.tuning import ESTIMATORS, METHODS, uses  # noqa: E402
 
 HEADER = "af_params.h"
 ESTIMATOR_STAGES = ("gyro_offset", "heading")  # the C names of blocks.pipeline.causal.ESTIMATORS, in its order
