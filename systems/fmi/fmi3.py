@@ -1,7 +1,7 @@
-"""The native estimator as an FMI 3.0 co-simulation FMU: built/native/fmi3/AttitudeEstimator.fmu
-(systems.fmi.native), which build_fmus copies into DIR/native/fmi3.
+"""The native FMUs as FMI 3.0 co-simulation FMUs: built/native/fmi3/<Name>.fmu for AttitudeEstimator,
+ImuSensor and MotionProfile (systems.fmi.native), which build_fmus copies into DIR/native/fmi3.
 
-The same model file and C core as the FMI 2.0 FMU, on the FMI 3.0 entry points of fmu_src/fmi3
+Each has the same model file and C core as its FMI 2.0 FMU, on the FMI 3.0 entry points of fmu_src/fmi3
 (which run the plumbing's instances, values and FMU states of fmu_src/fmi2), built against the
 fmi3 headers fmpy installs. Its modelDescription.xml is written from the same table of FMU
 variables (fmu_src.model_description.model_description3): Real as Float64, Integer as Int32,
@@ -18,7 +18,7 @@ import fmpy
 
 from attitude_fmu.systems.fmi import native
 
-FMI3_NAMES = ("AttitudeEstimator",)  # what build_fmus copies into DIR/native/fmi3
+FMI3_NAMES = ("AttitudeEstimator", "ImuSensor", "MotionProfile")  # what build_fmus copies into DIR/native/fmi3
 FOLDER = "native/fmi3"  # under native.BUILT
 
 

@@ -6,7 +6,7 @@ the package's folder, in BUILT:
     built/native/ImuSensor.fmu              the sensor model and the motions, in C from the simulation's
     built/native/MotionProfile.fmu          core (systems/simulation/core), the same interfaces as the pythonfmu ones
     built/native/NoOpEstimator.fmu          AttitudeEstimator's interface, nothing behind it: the benchmark's baseline
-    built/native/fmi3/AttitudeEstimator.fmu the estimator as FMI 3.0 co-simulation (systems.fmi.fmi3)
+    built/native/fmi3/<Name>.fmu            the estimator, the sensor and the motion as FMI 3.0 (systems.fmi.fmi3)
     built/fmi2_guard.so                     the pythonfmu FMUs' binary (systems.fmi.build)
     built/stepping.so                       the co-simulation master's stepping loop (systems.fmi.stepping)
     built/fmi_bench                         the C host of `attitude bench --fmu` (systems.evaluation.bench)
