@@ -1,6 +1,8 @@
-"""Build the project's FMUs: python build_fmu.py [--out DIR] (default dist/): the pythonfmu
-FMUs into DIR, the native ones (in C, no Python) into DIR/native, the FMI 3.0 estimator into
-DIR/native/fmi3.
+"""Build the project's FMUs: python build_fmu.py [--out DIR] [--platforms PLATFORMS] (default dist/,
+host): the pythonfmu FMUs into DIR, the native ones (in C, no Python) into DIR/native, their FMI 3.0
+versions into DIR/native/fmi3. With --platforms all (or a comma-separated list of FMI 3.0 platform
+tuples, e.g. x86_64-windows,aarch64-linux) the native FMUs also hold the binaries of those platforms,
+cross-compiled by CMake with zig's compiler (pip install ziglang; systems.fmi.platforms).
 
 Run from a clone, it first builds the clone with CMake (CMakeLists.txt, in the folder build/,
 with this Python, which needs fmpy and nanobind) and installs what is built into the clone's
@@ -11,8 +13,10 @@ build made those already.
 from __future__ import annotations
 
 import argparse
+import importlib.metadata
 import importlib.util
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -56,6 +60,14 @@ def cmake_build(build_dir, targets=(), options=(), source=ROOT) -> Path:
     return build_dir
 
 
+def project_version() -> str:
+    """The project's version: pyproject.toml's in a clone, else the installed distribution's."""
+    pyproject = ROOT / "pyproject.toml"
+    if pyproject.is_file():
+        return re.search(r'^version = "([^"]+)"', pyproject.read_text(encoding="utf-8"), re.MULTILINE).group(1)
+    return importlib.metadata.version("attitude-fmu")
+
+
 def build_clone(build_dir=ROOT / "build") -> None:
     """The clone built by CMake in build_dir, and what the build installs (the extension module,
     built/) put into the clone's folder, each file replaced whole: a process may have the old one loaded."""
@@ -72,13 +84,23 @@ def build_clone(build_dir=ROOT / "build") -> None:
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description="Build AttitudeEstimator.fmu, ImuSensor.fmu and MotionProfile.fmu "
-                                                 "(pythonfmu), the same in C (native/) and the estimator as FMI 3.0 "
-                                                 "(native/fmi3/).")
+                                                 "(pythonfmu), the same in C (native/) and as FMI 3.0 (native/fmi3/).")
     parser.add_argument("--out", type=Path, default=Path("dist"), help="output directory (default dist/)")
+    parser.add_argument("--platforms", default="host",
+                        help="the native FMUs' platforms besides this one: host (none, the default), all "
+                             "(x86_64-linux, aarch64-linux, x86_64-windows, x86_64-darwin, aarch64-darwin; Linux "
+                             "binaries for glibc 2.17) or a comma-separated list of those")
     args = parser.parse_args(argv)
+    package = _package()
+    from attitude_fmu.systems.fmi.platforms import parse_platforms
+
+    try:
+        platforms = parse_platforms(args.platforms)
+    except ValueError as exc:
+        parser.error(str(exc))
     if not __package__ and (ROOT / "CMakeLists.txt").is_file():  # a clone
         build_clone()
-    for path in _package().build_fmus(args.out):
+    for path in package.build_fmus(args.out, platforms=platforms):
         print(path)
     return 0
 

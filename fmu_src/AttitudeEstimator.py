@@ -6,8 +6,10 @@ same pipeline as `attitude estimate` (blocks.pipeline.online.OnlineEstimator). T
 parameters are those of every method and of the gyro-offset and heading estimators
 (blocks.pipeline.causal). Each starts at its default, so an importer shows the values the
 FMU runs with; one whose default is derived from others, or differs between the methods
-that share its name, starts at NaN, "unset" (its description says what that means).
-Parameters of a method or estimator that does not run must stay at their start values.
+that share its name, starts at a value that means "unset" (fmu_src.variables.tuning_parameters;
+its description says what that means). Parameters of a method or estimator that does not run
+must stay at their start values. The choices (method, heading, gyro_offset, gyr_samples,
+acc_samples) are Enumerations, whose items the command line's choices spell.
 """
 from __future__ import annotations
 
@@ -21,7 +23,7 @@ from attitude_fmu.fmu_src.variables import attitude_estimator, tuning_parameters
 
 def overrides(values) -> dict:
     """The tuning parameters (name → value) that differ from their start values: those the
-    estimator is given (NaN, unset, is never given)."""
+    estimator is given (NaN and the start value mean unset: never given)."""
     return {name: values[name] for name, (_, _, start) in tuning_parameters().items()
             if not math.isnan(values[name]) and values[name] != start}
 
@@ -29,29 +31,24 @@ def overrides(values) -> dict:
 class AttitudeEstimator(ProjectSlave):
     author = "attitude-fmu"
     description = "IMU attitude estimator (Rizun's optimal Wiener filter and peers); gravity up, ENU, q sensor->earth"
-    internal_state = ("estimator", "_warned_step")
+    internal_state = ("estimator", "_noted_step")
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
         self.register_table(attitude_estimator())
         self.estimator = None
-        self._warned_step = False
+        self._noted_step = False
 
     def initialise(self):
         if not (math.isfinite(self.Ts) and self.Ts > 0):
             self.fail(f"invalid parameter: Ts must be a finite positive number of seconds, got {self.Ts!r}")
             return
-        if self.heading not in ("mag", "gyro"):
-            self.fail(f"invalid parameter: heading must be 'mag' or 'gyro', got {self.heading!r}")
-            return
-        if self.gyro_offset not in ("on", "off"):
-            self.fail(f"invalid parameter: gyro_offset must be 'on' or 'off', got {self.gyro_offset!r}")
-            return
         params = overrides({name: getattr(self, name) for name in tuning_parameters()})
         try:
-            self.estimator = OnlineEstimator(self.method, params, heading=self.heading == "mag",
-                                             gyro_offset=self.gyro_offset == "on", latency=self.latency,
-                                             gyr_samples=self.gyr_samples, acc_samples=self.acc_samples)
+            self.estimator = OnlineEstimator(self.item("method"), params, heading=self.item("heading") == "mag",
+                                             gyro_offset=self.item("gyro_offset") == "on", latency=self.latency,
+                                             gyr_samples=self.item("gyr_samples"),
+                                             acc_samples=self.item("acc_samples"))
         except ValueError as exc:
             self.fail(f"invalid parameter: {exc}")
 
@@ -60,10 +57,10 @@ class AttitudeEstimator(ProjectSlave):
             return self.refuse_step()
         if self.estimator is None:
             return self.fail("doStep before initialisation")
-        if not self._warned_step and not same_step(step_size, self.Ts):
-            self._warned_step = True  # a master with variable steps would log every one
+        if not self._noted_step and not same_step(step_size, self.Ts):
+            self._noted_step = True  # a master with variable steps would log every one
             self.log(f"communication step {step_size:g} s differs from Ts = {self.Ts:g} s: filter re-discretised "
-                     "for it (and, without further warnings, for every other step size)", Fmi2Status.warning)
+                     "for it (and, without further notes, for every other step size)", Fmi2Status.ok)
         gyr = (self.gyr_x, self.gyr_y, self.gyr_z)
         acc = (self.acc_x, self.acc_y, self.acc_z)
         try:

@@ -2,7 +2,8 @@
 
 Each doStep(t, h) outputs the interval (t, t+h]: the mean angular rate over it, and the
 specific force, magnetic field and true orientation at t+h. Profile parameters are
-named <profile>_<parameter> and start at the profile's defaults.
+named <profile>_<parameter> and start at the profile's defaults; profile is an Enumeration of
+the profiles' names.
 """
 from __future__ import annotations
 
@@ -23,7 +24,7 @@ class MotionProfile(ProjectSlave):
 
     def initialise(self):
         try:
-            prof = profile(self.profile)
+            prof = profile(self.item("profile"))
             motion = prof.motion({p.name: getattr(self, f"{prof.name}_{p.name}") for p in prof.params}, g=self.g)
             self.stream = motion.stream(self.seed)
         except ValueError as exc:

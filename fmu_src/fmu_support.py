@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import copy
 import hashlib
+import importlib
 import importlib.machinery
 import importlib.util
 import pickle
@@ -19,8 +20,15 @@ from xml.etree.ElementTree import Element
 from pythonfmu import Boolean, Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Integer, Real, String
 from pythonfmu.enums import Fmi2Status
 
-from attitude_fmu.fmu_src.model_description import model_structure, model_variables, unit_definitions
-from attitude_fmu.fmu_src.variables import BOOLEAN, INTEGER, REAL, STRING, Table
+from attitude_fmu.fmu_src.model_description import (
+    default_experiment,
+    metadata,
+    model_structure,
+    model_variables,
+    type_definitions,
+    unit_definitions,
+)
+from attitude_fmu.fmu_src.variables import BOOLEAN, ENUMERATION, INTEGER, REAL, STRING, Table, item_name
 
 PACKAGE = "attitude_fmu"  # the modules of it an FMU imports are in its resources, under this name
 INTERNAL_STATE = " internal"  # key of a saved FMU state's model part (no variable name has a space)
@@ -142,14 +150,38 @@ class ProjectSlave(Fmi2Slave):
         """Build the model from the parameters; an invalid one: fail(message)."""
 
     def to_xml(self, model_options=None) -> Element:
-        """pythonfmu's model description with the variables' sections written from the table."""
+        """pythonfmu's model description with the variables' sections, the default experiment and
+        the metadata (version: the project's) written from the table, as the native FMUs' are."""
+        # the build's module, which the FMU does not carry: imported by name, as the build only writes
+        # the model description (systems.fmi.build.carried_files follows import statements)
+        project_version = importlib.import_module("attitude_fmu.build_fmu").project_version
         root = super().to_xml(model_options or {})
-        for name in ("ModelVariables", "ModelStructure"):
-            root.remove(root.find(name))
-        root.insert(list(root).index(root.find("CoSimulation")) + 1, unit_definitions(self.table))
+        for name in ("ModelVariables", "ModelStructure", "DefaultExperiment"):
+            if root.find(name) is not None:
+                root.remove(root.find(name))
+        root.attrib.update(metadata(project_version()))
+        at = list(root).index(root.find("CoSimulation")) + 1
+        root.insert(at, unit_definitions(self.table))
+        root.insert(at + 1, type_definitions(self.table))
+        root.insert(list(root).index(root.find("LogCategories")) + 1, default_experiment())
         root.append(model_variables(self.table))
         root.append(model_structure(self.table))
         return root
+
+    def item(self, name: str) -> str:
+        """The item name of the Enumeration variable name's value (sets are checked: item_name
+        refuses a value of an FMU state from elsewhere with ValueError)."""
+        return item_name(next(v for v in self.table if v.name == name), getattr(self, name))
+
+    def _set_item(self, variable, value) -> None:
+        """An Enumeration's setter: a value none of its items have is refused with an error logged
+        (fmi2Error through the guard) and the value kept, as the native FMUs do."""
+        try:
+            item_name(variable, value)
+        except ValueError as exc:
+            self.log(f"fmi2SetInteger: {exc}", Fmi2Status.error)
+            return
+        setattr(self, variable.name, value)
 
     def register(self, rows) -> None:
         """Register rows of self.table (fmu_src.variables.Variable) with pythonfmu, each
@@ -157,6 +189,8 @@ class ProjectSlave(Fmi2Slave):
         for v in rows:
             setattr(self, v.name, v.start)
             extra = {"initial": Fmi2Initial[v.initial]} if v.initial else {}
+            if v.type == ENUMERATION:  # pythonfmu has no Enumeration: an Integer whose sets are checked
+                extra["setter"] = lambda value, v=v: self._set_item(v, value)
             self.register_variable(_PYTHONFMU_TYPES[v.type](
                 v.name, causality=Fmi2Causality[v.causality], variability=Fmi2Variability[v.variability],
                 description=v.description, **extra), nested=False)
@@ -186,6 +220,6 @@ class ProjectSlave(Fmi2Slave):
         return False
 
 
-_PYTHONFMU_TYPES = {REAL: Real, INTEGER: Integer, BOOLEAN: Boolean, STRING: String}
+_PYTHONFMU_TYPES = {REAL: Real, INTEGER: Integer, BOOLEAN: Boolean, STRING: String, ENUMERATION: Integer}
 
 __all__ = ["ProjectSlave", "Fmi2Status"]

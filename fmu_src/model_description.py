@@ -1,14 +1,33 @@
 """Model descriptions written from a table of variables (fmu_src.variables): the FMI 2.0
-UnitDefinitions, ModelVariables and ModelStructure of every FMU the project builds
-(pythonfmu's through fmu_support.ProjectSlave.to_xml), and the whole document of a native
-one, FMI 2.0 (model_description) or 3.0 (model_description3; fmu_src/generate.py writes them).
-Only the standard library is imported: the build runs it."""
+UnitDefinitions, TypeDefinitions, DefaultExperiment, ModelVariables and ModelStructure and the
+metadata of every FMU the project builds (pythonfmu's through fmu_support.ProjectSlave.to_xml),
+and the whole document of a native one, FMI 2.0 (model_description) or 3.0 (model_description3;
+fmu_src/generate.py writes them). Only the standard library is imported: the build runs it."""
 from __future__ import annotations
 
 import math
+import os
+import time
 from xml.etree.ElementTree import Element, SubElement
 
-from attitude_fmu.fmu_src.variables import BOOLEAN, INTEGER, OUT, REAL, STRING, UNITS, Variable
+from attitude_fmu.fmu_src.variables import (
+    BOOLEAN,
+    DISPLAY_UNITS,
+    ENUMERATION,
+    INTEGER,
+    OUT,
+    QUANTITIES,
+    REAL,
+    STRING,
+    UNITS,
+    Variable,
+)
+
+AUTHOR = "attitude-fmu"
+COPYRIGHT = "Copyright (c) 2026 The attitude-fmu authors"  # as the project's LICENSE says it
+LICENSE = "MIT (documentation/licenses/LICENSE)"
+# the default experiment of every FMU: stepSize the estimator's default Ts (s), a stop time (s)
+DEFAULT_STEP, DEFAULT_STOP = 0.01, 10.0
 
 # the categories the native FMUs log in: pythonfmu's (the status of a message) and a trace of
 # the FMI calls, for debug logging
@@ -24,7 +43,7 @@ LOG_CATEGORIES = {
 
 def start_text(variable) -> str:
     """A start value as the model description writes it: Reals exactly (shortest round trip,
-    NaN as XML Schema spells it), Booleans true/false."""
+    NaN as XML Schema spells it), Booleans true/false, Enumerations by their value."""
     if variable.type == REAL:
         return "NaN" if math.isnan(variable.start) else repr(float(variable.start))
     if variable.type == BOOLEAN:
@@ -32,12 +51,60 @@ def start_text(variable) -> str:
     return str(variable.start)
 
 
+def metadata(version: str) -> dict[str, str]:
+    """The fmiModelDescription attributes that say what an FMU is (FMI 2.0 and 3.0 alike):
+    author, version (the project's), copyright, license and the generation time, the
+    environment's SOURCE_DATE_EPOCH (s since 1970) where set, so that a build can be repeated
+    byte for byte."""
+    epoch = os.environ.get("SOURCE_DATE_EPOCH")
+    stamp = time.gmtime(int(epoch) if epoch else None)
+    return {"author": AUTHOR, "version": version, "copyright": COPYRIGHT, "license": LICENSE,
+            "generationDateAndTime": time.strftime("%Y-%m-%dT%H:%M:%SZ", stamp)}
+
+
+def default_experiment() -> Element:
+    return Element("DefaultExperiment", startTime="0.0", stopTime=repr(DEFAULT_STOP), stepSize=repr(DEFAULT_STEP))
+
+
 def unit_definitions(variables) -> Element:
+    """Every unit the variables have, with its SI base units and its display units (rad: deg)."""
     definitions = Element("UnitDefinitions")
     for name in sorted({v.unit for v in variables if v.unit is not None}):
         unit = SubElement(definitions, "Unit", name=name)
         if UNITS[name] is not None:
             SubElement(unit, "BaseUnit", {k: str(v) for k, v in UNITS[name].items()})
+        if name in DISPLAY_UNITS:
+            display, factor = DISPLAY_UNITS[name]
+            SubElement(unit, "DisplayUnit", name=display, factor=repr(factor))
+    return definitions
+
+
+def _quantity(v: Variable) -> str | None:
+    """The physical quantity of a Real variable (QUANTITIES by its unit), its declared type's name."""
+    return QUANTITIES.get(v.unit) if v.type == REAL else None
+
+
+def _enumerations(variables) -> list[Variable]:
+    return [v for v in variables if v.type == ENUMERATION]
+
+
+def _items(node: Element, v: Variable) -> None:
+    for value, item in enumerate(v.items, 1):
+        SubElement(node, "Item", name=item, value=str(value))
+
+
+def type_definitions(variables) -> Element:
+    """FMI 2.0's SimpleTypes: a Real type per physical quantity of the variables (QUANTITIES:
+    its unit and display unit) and each Enumeration's items."""
+    definitions = Element("TypeDefinitions")
+    for unit, quantity in sorted(QUANTITIES.items(), key=lambda kv: kv[1]):
+        if any(_quantity(v) == quantity for v in variables):
+            real = SubElement(SubElement(definitions, "SimpleType", name=quantity), "Real", quantity=quantity,
+                              unit=unit)
+            if unit in DISPLAY_UNITS:
+                real.set("displayUnit", DISPLAY_UNITS[unit][0])
+    for v in _enumerations(variables):
+        _items(SubElement(SubElement(definitions, "SimpleType", name=v.declared_type), "Enumeration"), v)
     return definitions
 
 
@@ -49,31 +116,38 @@ def model_variables(variables) -> Element:
         if v.initial is not None:
             attributes["initial"] = v.initial
         scalar = SubElement(node, "ScalarVariable", attributes)
-        typed = SubElement(scalar, v.type, start=start_text(v))
+        typed = SubElement(scalar, v.type)
+        if v.type == ENUMERATION:
+            typed.set("declaredType", v.declared_type)
+        elif _quantity(v) is not None:
+            typed.set("declaredType", _quantity(v))
         if v.unit is not None:
             typed.set("unit", v.unit)
+        typed.set("start", start_text(v))
     return node
 
 
 def model_structure(variables) -> Element:
-    """The outputs, by their 1-based index in ModelVariables; none has an initial unknown (they start exact)."""
+    """The outputs, by their 1-based index in ModelVariables; none has an initial unknown (they
+    start exact). No output depends on an input within a step (dependencies=""): the outputs
+    after doStep(t, h) come from the inputs held over it, set before it."""
     structure = Element("ModelStructure")
     outputs = [k + 1 for k, v in enumerate(variables) if v.causality == OUT]
     if outputs:
         node = SubElement(structure, "Outputs")
         for index in outputs:
-            SubElement(node, "Unknown", index=str(index))
+            SubElement(node, "Unknown", index=str(index), dependencies="")
     return structure
 
 
-def model_description(name: str, description: str, guid: str, variables, generation_tool: str,
-                      source_files=()) -> Element:
+def model_description(name: str, description: str, guid: str, variables, version: str, source_files=()) -> Element:
     """The modelDescription.xml of an FMI 2.0 co-simulation FMU in C whose binary is named
     name (its model identifier): the variables of the table, the capabilities of the
-    project's FMI plumbing (fmu_src/fmi2), its sources (paths under sources/)."""
+    project's FMI plumbing (fmu_src/fmi2), its sources (paths under sources/), the metadata of
+    the project's version."""
     root = Element("fmiModelDescription", {
-        "fmiVersion": "2.0", "modelName": name, "guid": guid, "description": description, "author": "attitude-fmu",
-        "generationTool": generation_tool, "variableNamingConvention": "structured"})
+        "fmiVersion": "2.0", "modelName": name, "guid": guid, "description": description,
+        "generationTool": f"attitude-fmu {version}", "variableNamingConvention": "structured", **metadata(version)})
     cosimulation = SubElement(root, "CoSimulation", {
         "modelIdentifier": name, "needsExecutionTool": "false", "canHandleVariableCommunicationStepSize": "true",
         "canInterpolateInputs": "false", "maxOutputDerivativeOrder": "0", "canRunAsynchronuously": "false",
@@ -84,12 +158,19 @@ def model_description(name: str, description: str, guid: str, variables, generat
         for path in source_files:
             SubElement(files, "File", name=path)
     root.append(unit_definitions(variables))
-    categories = SubElement(root, "LogCategories")
-    for category, text in LOG_CATEGORIES.items():
-        SubElement(categories, "Category", name=category, description=text)
+    root.append(type_definitions(variables))
+    root.append(log_categories())
+    root.append(default_experiment())
     root.append(model_variables(variables))
     root.append(model_structure(variables))
     return root
+
+
+def log_categories() -> Element:
+    categories = Element("LogCategories")
+    for category, text in LOG_CATEGORIES.items():
+        SubElement(categories, "Category", name=category, description=text)
+    return categories
 
 
 FMI3_TYPES = {REAL: "Float64", INTEGER: "Int32"}  # the table's types that FMI 3.0 names otherwise
@@ -100,16 +181,34 @@ def time_variable(variables) -> Variable:
     return Variable("time", REAL, "independent", "continuous", 0.0, "simulation time", len(variables), "s")
 
 
+def type_definitions3(variables) -> Element:
+    """FMI 3.0's TypeDefinitions: a Float64Type per physical quantity of the variables and an
+    EnumerationType per Enumeration (as FMI 2.0's, type_definitions)."""
+    definitions = Element("TypeDefinitions")
+    for simple in type_definitions(variables):
+        (typed,) = simple
+        if typed.tag == "Real":
+            SubElement(definitions, "Float64Type", name=simple.get("name"), **typed.attrib)
+        else:
+            enumeration = SubElement(definitions, "EnumerationType", name=simple.get("name"))
+            enumeration.extend(typed)
+    return definitions
+
+
 def model_variables3(variables) -> Element:
-    """FMI 3.0's ModelVariables of the table: Real as Float64, Integer as Int32, Boolean and String
-    as themselves, with the same names, value references, causalities, units and start values,
-    and `time` after them."""
+    """FMI 3.0's ModelVariables of the table: Real as Float64, Integer as Int32, Boolean, String
+    and Enumeration as themselves, with the same names, value references, causalities, units,
+    declared types and start values, and `time` after them."""
     node = Element("ModelVariables")
     for v in (*variables, time_variable(variables)):
         attributes = {"name": v.name, "valueReference": str(v.value_reference), "description": v.description,
                       "causality": v.causality, "variability": v.variability}
         if v.initial is not None:
             attributes["initial"] = v.initial
+        if v.type == ENUMERATION:
+            attributes["declaredType"] = v.declared_type
+        elif _quantity(v) is not None:
+            attributes["declaredType"] = _quantity(v)
         if v.type != STRING and v.causality != "independent":
             attributes["start"] = start_text(v)
         if v.unit is not None:
@@ -120,14 +219,14 @@ def model_variables3(variables) -> Element:
     return node
 
 
-def model_description3(name: str, description: str, instantiation_token: str, variables,
-                       generation_tool: str) -> Element:
+def model_description3(name: str, description: str, instantiation_token: str, variables, version: str) -> Element:
     """The modelDescription.xml of an FMI 3.0 co-simulation FMU in C whose binary is named name,
-    with the capabilities of fmu_src/fmi3."""
+    with the capabilities of fmu_src/fmi3 and the metadata of the project's version. No output
+    depends on an input within a step (model_structure)."""
     root = Element("fmiModelDescription", {
         "fmiVersion": "3.0", "modelName": name, "instantiationToken": instantiation_token,
-        "description": description, "author": "attitude-fmu", "generationTool": generation_tool,
-        "variableNamingConvention": "structured"})
+        "description": description, "generationTool": f"attitude-fmu {version}",
+        "variableNamingConvention": "structured", **metadata(version)})
     SubElement(root, "CoSimulation", {
         "modelIdentifier": name, "needsExecutionTool": "false", "canBeInstantiatedOnlyOncePerProcess": "false",
         "canGetAndSetFMUState": "true", "canSerializeFMUState": "true", "providesDirectionalDerivatives": "false",
@@ -135,12 +234,12 @@ def model_description3(name: str, description: str, instantiation_token: str, va
         "maxOutputDerivativeOrder": "0", "providesIntermediateUpdate": "false",
         "canReturnEarlyAfterIntermediateUpdate": "false", "hasEventMode": "false"})
     root.append(unit_definitions([*variables, time_variable(variables)]))
-    categories = SubElement(root, "LogCategories")
-    for category, text in LOG_CATEGORIES.items():
-        SubElement(categories, "Category", name=category, description=text)
+    root.append(type_definitions3([*variables, time_variable(variables)]))
+    root.append(log_categories())
+    root.append(default_experiment())
     root.append(model_variables3(variables))
     structure = SubElement(root, "ModelStructure")
     for v in variables:
         if v.causality == OUT:
-            SubElement(structure, "Output", valueReference=str(v.value_reference))
+            SubElement(structure, "Output", valueReference=str(v.value_reference), dependencies="")
     return root

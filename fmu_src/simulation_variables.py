@@ -44,7 +44,7 @@ def motion_profile() -> tuple[Variable, ...]:
     t.vector("f", (0.0, 0.0, 9.81), "m/s2", "true specific force {c}, sensor coordinates", OUT)
     t.vector("m", EARTH_FIELD_UT, "uT", "true magnetic field {c}, sensor coordinates", OUT)
     t.vector("qt", (1.0, 0.0, 0.0, 0.0), "1", "true orientation quaternion {c}, sensor -> earth (ENU)", OUT, "wxyz")
-    t.parameter("profile", "human", f"motion profile: {', '.join(PROFILES)}")
+    t.choice("profile", PROFILES, "human", "motion profile")
     t.parameter("seed", 0, "seed of random profiles (systems.simulation.noise)", INTEGER)
     t.real("g", 9.81, "m/s2", "magnitude of gravity", PAR)
     for name, (_, params) in PROFILES.items():

@@ -10,13 +10,15 @@ references. Only the standard library is imported (and blocks/tuning.py): the bu
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from functools import cache
 
 from attitude_fmu.blocks.tuning import METHODS, uses
 
-REAL, INTEGER, BOOLEAN, STRING = "Real", "Integer", "Boolean", "String"
+# the sample conventions, as blocks.stages.timing (the C core's stages/timing.c) lists them
+GYR_SAMPLES, ACC_SAMPLES = ("mean", "point"), ("point", "mean")
+
+REAL, INTEGER, BOOLEAN, STRING, ENUMERATION = "Real", "Integer", "Boolean", "String", "Enumeration"
 IN, OUT, PAR = "input", "output", "parameter"
 
 # FMI unit name → SI base-unit exponents (FMI 2.0 BaseUnit attributes); None for the
@@ -38,6 +40,11 @@ UNITS = {
     "uT/sqrt(Hz)": None,
     "1": {},
 }
+# FMI unit name → (display unit, factor: display value per value): angles shown in degrees
+DISPLAY_UNITS = {"rad": ("deg", 57.29577951308232)}
+# FMI unit name → the physical quantity of the Real variables of that unit (their declared type)
+QUANTITIES = {"rad": "Angle", "rad/s": "AngularVelocity", "m/s2": "Acceleration", "uT": "MagneticFluxDensity",
+              "s": "Time", "m": "Length", "Hz": "Frequency"}
 
 
 def fmi_unit(unit: str) -> str:
@@ -50,9 +57,10 @@ def fmi_unit(unit: str) -> str:
 
 @dataclass(frozen=True)
 class Variable:
-    """One FMI variable. type: REAL, INTEGER, BOOLEAN or STRING; causality: IN, OUT or PAR;
-    variability and initial as FMI 2.0 spells them (initial None: not stated); unit: an
-    FMI unit name of UNITS (Real only)."""
+    """One FMI variable. type: REAL, INTEGER, BOOLEAN, STRING or ENUMERATION; causality: IN, OUT
+    or PAR; variability and initial as FMI 2.0 spells them (initial None: not stated); unit: an
+    FMI unit name of UNITS (Real only); items: an Enumeration's item names, whose values are
+    1, 2, …, n in that order (its start is one of those values)."""
 
     name: str
     type: str
@@ -63,16 +71,46 @@ class Variable:
     value_reference: int
     unit: str | None = None
     initial: str | None = None
+    items: tuple[str, ...] = ()
+
+    @property
+    def declared_type(self) -> str:
+        """The name of an Enumeration's type in the model description: its name in CamelCase."""
+        return "".join(part.capitalize() for part in self.name.split("_"))
+
+
+def item_value(variable: Variable, name: str) -> int:
+    """The value (1, 2, …) of the item name of an Enumeration variable; ValueError naming the
+    allowed items if it has no such item."""
+    if name not in variable.items:
+        allowed = ", ".join(variable.items) or "none: not an Enumeration"
+        raise ValueError(f"{variable.name} must be one of {allowed}; got {name!r}")
+    return variable.items.index(name) + 1
+
+
+def items_text(variable: Variable) -> str:
+    """An Enumeration's items as messages list them: "1 mag, 2 gyro"."""
+    return ", ".join(f"{value} {name}" for value, name in enumerate(variable.items, 1)) or "none: not an Enumeration"
+
+
+def item_name(variable: Variable, value: int) -> str:
+    """The item name of the value (1, 2, …) of an Enumeration variable; ValueError naming the
+    items if it has no item of that value."""
+    if not (isinstance(value, int) and 1 <= value <= len(variable.items)):
+        raise ValueError(f"{variable.name} must be one of its items ({items_text(variable)}), got {value!r}")
+    return variable.items[value - 1]
 
 
 class Table(list):
     """Variables in the order of their value references 0, 1, 2, …; each helper appends
     its rows and returns them."""
 
-    def add(self, name, type_, causality, variability, start, description, unit=None, initial=None) -> list[Variable]:
+    def add(self, name, type_, causality, variability, start, description, unit=None, initial=None,
+            items=()) -> list[Variable]:
         if unit is not None and unit not in UNITS:
             raise ValueError(f"unit {unit!r} has no definition in fmu_src.variables.UNITS")
-        self.append(Variable(name, type_, causality, variability, start, description, len(self), unit, initial))
+        self.append(Variable(name, type_, causality, variability, start, description, len(self), unit, initial,
+                             tuple(items)))
         return self[-1:]
 
     def real(self, name, start, unit, description, causality) -> list[Variable]:
@@ -85,9 +123,18 @@ class Table(list):
         return [v for c, value in zip(components, start)
                 for v in self.real(f"{prefix}_{c}", value, unit, description.format(c=c), causality)]
 
-    def parameter(self, name, start, description, type_=STRING) -> list[Variable]:
-        """A fixed String, Integer or Boolean parameter."""
+    def parameter(self, name, start, description, type_=INTEGER) -> list[Variable]:
+        """A fixed Integer or Boolean parameter."""
         return self.add(name, type_, PAR, "fixed", start, description)
+
+    def choice(self, name, items, start, description) -> list[Variable]:
+        """A fixed Enumeration parameter: one of the item names (as the command line spells
+        them), start the one it starts at; the description lists them."""
+        items = tuple(items)
+        if start not in items or len(set(items)) != len(items):
+            raise ValueError(f"{name}: start {start!r} must be one of the distinct items {items}")
+        return self.add(name, ENUMERATION, PAR, "fixed", items.index(start) + 1,
+                        f"{description} (items: {', '.join(items)})", items=items)
 
     def boolean_output(self, name, start, description) -> list[Variable]:
         return self.add(name, BOOLEAN, OUT, "discrete", bool(start), description, initial="exact")
@@ -104,8 +151,15 @@ class Table(list):
 
 def tuning_parameters() -> dict:
     """Every method's tuning parameters and those of the gyro-offset and heading
-    estimators, once each: name → (FMI unit, description, start value). The start value is
-    the default where every stage with the name has that one default, else NaN: unset."""
+    estimators, once each: name → (FMI unit, description, start value).
+
+    The start value is the default where every stage with the name has that one default.
+    Where the stages' defaults differ, it is the first stage's default that is a number;
+    where none has a number (unset: the default is derived from other parameters or from
+    the data, or the stage does without), it is a value outside the parameter's range: 0, or
+    -1 where 0 is in it. Either way a value equal to the start means "unset": each stage that
+    runs takes its own default when the FMU is initialised, as the descriptions say (so does
+    NaN)."""
     params = {}
     for name, stages in uses().items():
         first = stages[0][1]
@@ -113,12 +167,15 @@ def tuning_parameters() -> dict:
         if len(defaults) == 1 and first.default is not None:
             params[name] = (fmi_unit(first.unit), f"{first.doc}; default {first.default:g}", first.default)
             continue
+        numbers = [p.default for _, p in stages if p.default is not None]
+        start = numbers[0] if numbers else (-1.0 if first.allow_zero else 0.0)
         if defaults == {None}:
-            doc = f"{first.doc}; NaN (the start value): unset"
+            doc = f"{first.doc}; {start:g} (the start value): unset, taken when the FMU is initialised"
         else:
-            each = "; ".join(f"{owner}: {'unset' if p.default is None else format(p.default, 'g')}" for owner, p in stages)
-            doc = f"{first.doc}; NaN (the start value): the default of the stage that runs ({each})"
-        params[name] = (fmi_unit(first.unit), doc, math.nan)
+            each = "; ".join(f"{owner}: {'unset' if p.default is None else format(p.default, 'g')}"
+                             for owner, p in stages)
+            doc = f"{first.doc}; {start:g} (the start value): the default of the stage that runs ({each})"
+        params[name] = (fmi_unit(first.unit), doc, start)
     return params
 
 
@@ -142,18 +199,18 @@ def attitude_estimator() -> tuple[Variable, ...]:
     t.real("mag_delay_used", 0.0, "s", "the magnetometer's delay behind the gyro the heading allows for "
            "(the parameter mag_delay, or its online estimate: 0 until one is taken)", OUT)
     t.boolean_output("valid", False, "an estimate is available and the last inputs were finite")
-    t.parameter("method", "wiener", f"estimator: {', '.join(METHODS)}")
-    t.parameter("heading", "mag", "heading source: mag (magnetometer, hard iron fitted, guarded against "
-                "disturbances) or gyro")
-    t.parameter("gyro_offset", "on", "on (default, as attitude estimate): estimate and remove the gyro offset "
-                "(at rest and while moving); off: for a gyro without offset")
+    t.choice("method", METHODS, "wiener", "estimator")
+    t.choice("heading", ("mag", "gyro"), "mag", "heading source: mag (magnetometer, hard iron fitted, guarded "
+             "against disturbances) or gyro")
+    t.choice("gyro_offset", ("on", "off"), "on", "on (default, as attitude estimate): estimate and remove the gyro "
+             "offset (at rest and while moving); off: for a gyro without offset")
     t.real("Ts", 0.01, "s", "sample time the estimator expects (other step sizes are re-discretised)", PAR)
-    t.parameter("gyr_samples", "mean", "mean: gyr is the mean rate over the step (the FMI convention of "
-                "MotionProfile and ImuSensor); point: the rate at the step's end (most models' outputs), "
-                "averaged with the last one")
-    t.parameter("acc_samples", "point", "point: acc is the specific force at the step's end (the FMI "
-                "convention of MotionProfile and ImuSensor); mean: its mean over the step (a sensor that "
-                "averages it as the gyro), turned to the step's end by half the step's rotation")
+    t.choice("gyr_samples", GYR_SAMPLES, "mean", "mean: gyr is the mean rate over the step (the FMI convention of "
+             "MotionProfile and ImuSensor); point: the rate at the step's end (most models' outputs), "
+             "averaged with the last one")
+    t.choice("acc_samples", ACC_SAMPLES, "point", "point: acc is the specific force at the step's end (the FMI "
+             "convention of MotionProfile and ImuSensor); mean: its mean over the step (a sensor that "
+             "averages it as the gyro), turned to the step's end by half the step's rotation")
     t.real("latency", 0.0, "s", "the IMU's delay behind the motion (its filters' group delay, gyr taken as the "
            "mean rate over the step); q and g are carried forward over it with the gyro", PAR)
     for name, (unit, doc, start) in tuning_parameters().items():

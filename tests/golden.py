@@ -209,8 +209,8 @@ def simulation_case():
     out["normals first"] = normals(2**64 - 1, SENSOR, 5, first=10**12)
     human = HumanMotion(delta_v=0.7, rot_rms=1.2).generate(3.0, 100.0, seed=3)
     out.update({"human quat": human.quat, "human gyr": human.gyr, "human acc": human.acc})
-    for name in PROFILES:
-        motion = profile(name).motion().generate(3.0, 50.0)
+    for name in PROFILES:  # the human motion on a grid of one cell per sample: the process frozen here
+        motion = profile(name).motion({"grid": 1 / 50.0} if name == "human" else None).generate(3.0, 50.0)
         out.update({f"{name} quat": motion.quat, f"{name} gyr": motion.gyr, f"{name} acc": motion.acc})
     model = ImuModel(delta_n=math.radians(0.1), gyr_offset=(0.01, 0.0, -0.02),
                      gyr_scale=((0.01, 0.002, 0.0), (0.0, -0.01, 0.003), (0.001, 0.0, 0.02)), acc_noise=0.02,
@@ -278,7 +278,9 @@ FMU_STEP = 0.01  # s
 def _simulate(fmu, start_values, inputs=None, n=600, outputs=None):
     """fmpy's simulation of the FMU over n steps of FMU_STEP: input column k drives the step
     that ends at (k+1)·FMU_STEP; the outputs after each step (row 0: before the first, left out)."""
-    from fmpy import simulate_fmu
+    from fmpy import read_model_description, simulate_fmu
+
+    from attitude_fmu.systems.fmi.cosim import start_values as fmu_start_values
 
     signals = None
     if inputs is not None:
@@ -286,7 +288,8 @@ def _simulate(fmu, start_values, inputs=None, n=600, outputs=None):
         signals["time"] = np.arange(n) * FMU_STEP
         for name, column in inputs.items():
             signals[name] = column
-    result = simulate_fmu(str(fmu), start_values=start_values, input=signals, step_size=FMU_STEP,
+    result = simulate_fmu(str(fmu), start_values=fmu_start_values(read_model_description(str(fmu)), start_values),
+                          input=signals, step_size=FMU_STEP,
                           output_interval=FMU_STEP, stop_time=n * FMU_STEP, output=outputs)
     return np.column_stack([result[name] for name in outputs])[1:]
 
@@ -311,7 +314,9 @@ def fmu_cases(folder) -> dict[str, dict[str, np.ndarray]]:
     motion = folder / "native" / "MotionProfile.fmu"
     for name in ("human", "lever_arm", "incline", "coning", "sine_rotation", "step_rotation", "linear_motion",
                  "offset_rotation"):
-        out[f"MotionProfile {name}"] = {"out": _simulate(motion, {"profile": name, "seed": 3}, n=300, outputs=truth)}
+        grid = {"human_grid": FMU_STEP} if name == "human" else {}  # one cell a step: the process frozen here
+        out[f"MotionProfile {name}"] = {"out": _simulate(motion, {"profile": name, "seed": 3, **grid}, n=300,
+                                                         outputs=truth)}
     human = out["MotionProfile human"]["out"]
     sensor_inputs = {name: human[:, i] for i, name in enumerate(truth[:9])}
     out["ImuSensor"] = {"out": _simulate(

@@ -4,6 +4,7 @@ import importlib.util
 import json
 import math
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -13,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from fmpy import read_model_description
+from fmpy import extract, read_model_description
 from fmpy.fmi1 import FMICallException
 from fmpy.ssp.simulation import simulate_ssp
 from fmpy.validation import validate_fmu
@@ -33,7 +34,7 @@ from attitude_fmu.systems.fmi.build import (
     python_environment,
     source_fingerprint,
 )
-from attitude_fmu.systems.fmi.cosim import FmuRunner, cosimulate, cosimulate_libcosim
+from attitude_fmu.systems.fmi.cosim import FmuRunner, cosimulate, cosimulate_libcosim, load_slave
 from attitude_fmu.systems.fmi.ssp import write_ssp
 from attitude_fmu.systems.simulation.motion import HumanMotion, profile
 from attitude_fmu.systems.simulation.sensor_model import ImuModel
@@ -90,9 +91,11 @@ def test_every_fmu_validates(fmu_dir):
 
 
 def test_parameters_start_at_their_defaults_and_an_importer_may_set_every_start_value(fmu_dir, recording):
-    """Each tuning parameter's start value is the default it runs with (NaN, unset, where the
-    default is derived, or differs between methods); an importer that sets every parameter
-    to its start value (as some do) runs the defaults, also for a method that lacks most."""
+    """Each tuning parameter's start value is the default it runs with; where the default
+    differs between the stages with the name, the first number among them; where none has a
+    number (derived, or the stage does without), a value outside its range (0, or -1 where 0
+    is allowed). None is NaN. An importer that sets every parameter to its start value (as some
+    do) runs the defaults, also for a method that lacks most."""
     from attitude_fmu.blocks.pipeline.causal import ESTIMATORS
 
     md = read_model_description(str(fmu_dir / "AttitudeEstimator.fmu"))
@@ -101,10 +104,16 @@ def test_parameters_start_at_their_defaults_and_an_importer_may_set_every_start_
         for p in stage:
             shared = {q.default for s in (*(m.params for m in METHODS.values()), *ESTIMATORS.values())
                       for q in s if q.name == p.name}
-            expected = p.default if len(shared) == 1 and p.default is not None else math.nan
-            assert start[p.name] == expected or math.isnan(start[p.name]) and math.isnan(expected), p.name
+            numbers = sorted(shared - {None})
+            if len(shared) == 1 and p.default is not None:
+                assert start[p.name] == p.default, p.name
+            elif numbers:
+                assert start[p.name] in numbers, p.name
+            else:
+                assert start[p.name] == (-1.0 if p.allow_zero else 0.0), p.name
     assert start["delta_n"] == math.radians(0.1) and start["k_I"] == 0.3 and start["tau_heading"] == 10.0
-    assert math.isnan(start["omega_c"]) and math.isnan(start["mag_delay"])
+    assert start["omega_c"] == 10.0 and start["mag_delay"] == -1.0 and start["omega_g"] == 0.0
+    assert not [name for name, value in start.items() if math.isnan(value)]
     gyr, acc = recording
     for method in ("wiener", "mahony"):
         every = {name: value for name, value in start.items() if name not in ("Ts", "latency")}
@@ -382,13 +391,8 @@ def test_estimator_fmu_takes_a_zero_where_zero_is_a_setting(fmu_dir, recording, 
 @pytest.mark.parametrize("parameters, message", [
     ({"delta_n": -1.0}, "delta_n must be a finite positive number"),
     ({"method": "mahony", "scale_error": 0.0}, "unknown parameter 'scale_error'"),
-    ({"method": "kalman"}, "unknown method 'kalman'"),
     ({"method": "wiener", "omega_f": 0.1}, "unknown parameter 'omega_f'"),
-    ({"heading": "compass"}, "heading must be 'mag' or 'gyro'"),
-    ({"gyro_offset": "yes"}, "gyro_offset must be 'on' or 'off'"),
     ({"latency": 1.0}, "latency must be a finite number of seconds within"),
-    ({"gyr_samples": "midpoint"}, "gyr_samples must be 'mean' or 'point'"),
-    ({"acc_samples": "end"}, "acc_samples must be 'point' or 'mean'"),
 ])
 def test_invalid_parameter_ends_initialisation_in_fmi2_error(fmu_dir, parameters, message, capsys):
     """The model logs the error (a Python exception would end in fmi2Fatal and corrupt the
@@ -423,7 +427,6 @@ def test_an_fmu_of_other_code_than_the_process_has_loaded_ends_initialisation_in
     ("ImuSensor", {"seed": -3}, "seed must be a whole number in [0, 2**64), got -3"),
     ("ImuSensor", {"latency": -0.01}, "latency must be finite and non-negative"),
     ("ImuSensor", {"mag_noise": -0.1}, "mag_noise must be finite and non-negative"),
-    ("MotionProfile", {"profile": "jogging"}, "jogging"),
     ("MotionProfile", {"seed": -3}, "seed must be a whole number in [0, 2**64), got -3"),
 ])
 def test_invalid_parameters_of_the_other_fmus_end_in_fmi2_error(fmu_dir, name, parameters, message, capsys):
@@ -432,6 +435,46 @@ def test_invalid_parameters_of_the_other_fmus_end_in_fmi2_error(fmu_dir, name, p
     assert info.value.status == 3
     log = capsys.readouterr().out
     assert "[ERROR] invalid parameter" in log and message in log, log
+
+
+@pytest.mark.parametrize("name, parameters, message", [
+    ("AttitudeEstimator", {"method": "kalman"},
+     "method must be one of wiener, tseng, tseng_adaptive, luinge, mahony, first_order; got 'kalman'"),
+    ("AttitudeEstimator", {"heading": "compass"}, "heading must be one of mag, gyro; got 'compass'"),
+    ("AttitudeEstimator", {"gyro_offset": "yes"}, "gyro_offset must be one of on, off; got 'yes'"),
+    ("AttitudeEstimator", {"gyr_samples": "midpoint"}, "gyr_samples must be one of mean, point; got 'midpoint'"),
+    ("AttitudeEstimator", {"acc_samples": 3}, "acc_samples must be one of point, mean; got 3"),
+    ("MotionProfile", {"profile": "jogging"}, "profile must be one of human, lever_arm, incline, coning"),
+])
+def test_a_choice_by_a_name_none_of_its_items_has_is_refused_naming_them(fmu_dir, name, parameters, message):
+    """The choices are Enumerations: the project's master takes their item names and refuses,
+    before any FMI call, a name (or value) none of the items has, naming the items."""
+    with pytest.raises(ValueError, match=re.escape(message)):
+        FmuRunner(fmu_dir / f"{name}.fmu", parameters)
+
+
+@pytest.mark.parametrize("name, choice, value, items", [
+    ("AttitudeEstimator", "method", 7, "1 wiener, 2 tseng, 3 tseng_adaptive, 4 luinge, 5 mahony, 6 first_order"),
+    ("AttitudeEstimator", "heading", 0, "1 mag, 2 gyro"),
+    ("MotionProfile", "profile", -1, "1 human, 2 lever_arm"),
+])
+def test_an_enumeration_value_out_of_its_items_range_ends_in_fmi2_error(fmu_dir, name, choice, value, items, capsys):
+    """fmi2SetInteger of a value none of an Enumeration's items has: fmi2Error from the set
+    (pythonfmu through the FMU's guard), a message naming the items, the value unchanged."""
+    md = read_model_description(str(fmu_dir / f"{name}.fmu"))
+    vr = next(v.valueReference for v in md.modelVariables if v.name == choice)
+    slave = load_slave(md, extract(str(fmu_dir / f"{name}.fmu")), "choices")
+    slave.instantiate(loggingOn=True)
+    slave.setupExperiment(startTime=0.0)
+    slave.enterInitializationMode()
+    with pytest.raises(FMICallException) as info:
+        slave.setInteger([vr], [value])
+    assert info.value.status == 3
+    log = capsys.readouterr().out
+    assert f"{choice} must be one of its items ({items}" in log and f"got {value}" in log, log
+    slave.reset()
+    assert slave.getInteger([vr]) == [1]
+    slave.freeInstance()
 
 
 def test_a_late_sensor_fmu_refuses_a_changed_step(fmu_dir, capsys):
@@ -702,7 +745,6 @@ def test_guard_reports_a_missing_pythonfmu_library_instead_of_crashing(fmu_dir, 
     from fmpy import extract, read_model_description
 
     from attitude_fmu.systems.fmi.build import PYTHONFMU_LIBRARY
-    from attitude_fmu.systems.fmi.cosim import load_slave
 
     broken = tmp_path / "AttitudeEstimator.fmu"
     with zipfile.ZipFile(fmu_dir / "AttitudeEstimator.fmu") as src, zipfile.ZipFile(broken, "w") as dst:
@@ -733,20 +775,21 @@ def test_libcosim_runs_the_ssp_diagram_and_its_estimator_computes_ours(fmu_dir, 
     which each connection delays by one step and inputs begin at their start values. The
     motion it records is the batch path's, and the estimator's outputs are those of
     blocks.pipeline.online on the inputs libcosim handed it: its FMI calls, the SSP's parameters
-    (String and Real, not the defaults) and its step size (kept in integer nanoseconds)
-    all came through."""
+    (Integer and Real, not the defaults) and its step size (kept in integer nanoseconds) all
+    came through. libcosim ignores FMI Enumeration variables (it warns): the choices stay at
+    their start values (profile human, method wiener, heading mag)."""
     ssp = write_ssp(tmp_path / "human.ssp", fmu_dir, {
-        "motion": {"profile": "human", "seed": 3},
+        "motion": {"seed": 3},
         "imu": {"delta_n": math.radians(0.1), "seed": 4, **{f"gyr_scale_{r}_{c}": GYR_SCALE[i][j]
                                                             for i, r in enumerate("xyz") for j, c in enumerate("xyz")}},
-        "estimator": {"method": "wiener", "heading": "gyro", "delta_n": 0.003}}, 10.0, 1 / FS)
+        "estimator": {"delta_n": 0.003}}, 10.0, 1 / FS)
     pytest.importorskip("libcosimpy")
     inputs = [f"{s}_{a}" for s in ("gyr", "acc", "mag") for a in "xyz"]
     out = cosimulate_libcosim(ssp, 10.0, 1 / FS)
     motion = profile("human").motion().generate(10.0, FS, 3)
     assert np.abs(np.column_stack([out[f"motion.qt_{c}"] for c in "wxyz"]) - motion.quat).max() < 1e-12
 
-    online = OnlineEstimator("wiener", {"delta_n": 0.003}, heading=False, gyro_offset=True)
+    online = OnlineEstimator("wiener", {"delta_n": 0.003}, heading=True, gyro_offset=True)
     received = np.column_stack([out[f"estimator.{n}"] for n in inputs])
     expected, valid = [], []
     for row in received:
@@ -809,15 +852,15 @@ def test_libcosim_and_our_master_hold_the_human_row_of_verify_to_its_bound(fmu_d
     """attitude verify's human × wiener configuration, 300 s, under both masters: the
     inclination error against the closed-form truth (libcosim's estimate two steps late,
     one per connection) is within verify's bound (1.3 × eq. 41) under each, and the two
-    agree within 2 %."""
+    agree within 2 %. libcosim ignores FMI Enumeration variables: the choices stay at their
+    start values (human, wiener; the gyro offset estimated, as verify's runs do not)."""
     pytest.importorskip("libcosimpy")
     from attitude_fmu.blocks.filters.earth_filters import settle_time
     from attitude_fmu.systems.fmi.verify import SCENARIOS, STEP_S
 
     scenario = SCENARIOS["human"]
     ssp = write_ssp(tmp_path / "human.ssp", fmu_dir, {
-        "motion": {"profile": "human", "seed": 3}, "imu": dict(scenario.imu),
-        "estimator": {"method": "wiener", "Ts": STEP_S, "gyro_offset": "off"}}, 300.0, STEP_S)
+        "motion": {"seed": 3}, "imu": dict(scenario.imu), "estimator": {"Ts": STEP_S}}, 300.0, STEP_S)
     start = int(math.ceil(settle_time(METHODS["wiener"].filter()) / STEP_S))
     errors = {}
     for name, run, lag in (("ours", cosimulate, 0), ("libcosim", cosimulate_libcosim, 2)):

@@ -6,7 +6,7 @@ import numpy as np
 from fmpy.fmi1 import FMICallException
 
 from attitude_fmu.blocks.pipeline.batch import estimate
-from attitude_fmu.systems.fmi.cosim import FmuRunner
+from attitude_fmu.systems.fmi.cosim import FmuRunner, set_value
 from attitude_fmu.systems.simulation.motion import HumanMotion
 from attitude_fmu.systems.simulation.sensor_model import ImuModel
 from tests.test_fmu import FS, INPUTS, OUTPUTS
@@ -34,10 +34,10 @@ def test_calls_in_the_wrong_phase_or_on_the_wrong_type_end_in_fmi2_error_and_har
     fmu.setupExperiment(startTime=0.0)
     fmu.enterInitializationMode()
     statuses.update({"setString on a Real": status(lambda: fmu.setString([vr["Ts"]], ["0.01"])),
-                     "setReal on a String": status(lambda: fmu.setReal([vr["method"]], [1.0])),
+                     "setReal on an Enumeration": status(lambda: fmu.setReal([vr["method"]], [1.0])),
                      "getReal on a Boolean": status(lambda: fmu.getReal([vr["valid"]])),
                      "setReal on no variable": status(lambda: fmu.setReal([100000], [1.0]))})
-    fmu.setString([vr["gyro_offset"]], ["off"])
+    set_value(fmu, runner.variables["gyro_offset"], "off")
     fmu.exitInitializationMode()
     runner.time = 0.0
     out, _ = runner.run(np.hstack([gyr, acc]), 1 / FS)
@@ -49,7 +49,7 @@ def test_calls_in_the_wrong_phase_or_on_the_wrong_type_end_in_fmi2_error_and_har
     log = capsys.readouterr().out
     for message in ("fmi2DoStep refused: not allowed before initialisation",
                     f"fmi2SetString refused: value reference {vr['Ts']} is a Real variable, not a String",
-                    f"fmi2SetReal refused: value reference {vr['method']} is a String variable, not a Real",
+                    f"fmi2SetReal refused: value reference {vr['method']} is an Integer variable, not a Real",
                     "fmi2SetReal refused: value reference 100000 names no variable",
                     "fmi2DoStep refused: not allowed after fmi2Terminate"):
         assert message in log, log

@@ -17,15 +17,25 @@ from fmpy.ssp.ssd import read_ssd
 from fmpy.validation import validate_fmu
 
 from attitude_fmu.blocks.methods.registry import METHODS
+from attitude_fmu.fmu_src.simulation_variables import motion_profile
+from attitude_fmu.fmu_src.variables import item_value
 from attitude_fmu.systems.fmi import stepping
 from attitude_fmu.systems.fmi import verify as verify_module
-from attitude_fmu.systems.fmi.cosim import FmuRunner, cosimulate, cosimulate_libcosim, load_slave
+from attitude_fmu.systems.fmi.cosim import (
+    FmuRunner,
+    cosimulate,
+    cosimulate_libcosim,
+    enumeration_value,
+    load_slave,
+    set_value,
+)
 from attitude_fmu.systems.fmi.ssp import write_ssp
 from attitude_fmu.systems.simulation.motion import PROFILES, HumanMotion
 from attitude_fmu.systems.simulation.sensor_model import ImuModel
 
 FS = 100.0
-NATIVE_FMUS = ("native/AttitudeEstimator", "native/ImuSensor", "native/MotionProfile", "native/fmi3/AttitudeEstimator")
+NATIVE_FMUS = ("native/AttitudeEstimator", "native/ImuSensor", "native/MotionProfile", "native/fmi3/AttitudeEstimator",
+               "native/fmi3/ImuSensor", "native/fmi3/MotionProfile")
 TRUTH = [f"{s}_{a}" for s in ("omega", "f", "m") for a in "xyz"] + [f"qt_{c}" for c in "wxyz"]
 SENSOR_IN = [f"{s}_{a}" for s in ("omega", "f", "m") for a in "xyz"]
 SENSOR_OUT = [f"{s}_{a}" for s in ("gyr", "acc", "mag") for a in "xyz"]
@@ -33,16 +43,21 @@ ESTIMATOR_OUT = ["q_w", "q_x", "q_y", "q_z", "g_x", "g_y", "g_z", "roll", "pitch
                  "gyr_offset_y", "gyr_offset_z", "mag_offset_x", "mag_offset_y", "mag_offset_z", "mag_delay_used"]
 
 
-def test_every_native_fmu_validates_and_fmi3_has_the_fmi2_variables(fmu_dir):
-    for name in NATIVE_FMUS:
-        assert validate_fmu(str(fmu_dir / f"{name}.fmu")) == [], name
-    two = read_model_description(str(fmu_dir / "native" / "AttitudeEstimator.fmu"))
-    three = read_model_description(str(fmu_dir / "native" / "fmi3" / "AttitudeEstimator.fmu"))
-    assert three.fmiVersion == "3.0" and three.coSimulation.modelIdentifier == "AttitudeEstimator"
-    kinds = {"Real": "Float64", "Boolean": "Boolean", "String": "String"}
+@pytest.mark.parametrize("name", ["AttitudeEstimator", "ImuSensor", "MotionProfile"])
+def test_every_native_fmu_validates_and_fmi3_has_the_fmi2_variables(fmu_dir, name):
+    for path in NATIVE_FMUS:
+        assert validate_fmu(str(fmu_dir / f"{path}.fmu")) == [], path
+    two = read_model_description(str(fmu_dir / "native" / f"{name}.fmu"))
+    three = read_model_description(str(fmu_dir / "native" / "fmi3" / f"{name}.fmu"))
+    assert three.fmiVersion == "3.0" and three.coSimulation.modelIdentifier == name
+    kinds = {"Real": "Float64", "Integer": "Int32", "Boolean": "Boolean", "Enumeration": "Enumeration"}
     rows = [(v.name, v.valueReference, v.causality, v.variability, v.start) for v in two.modelVariables]
     assert [(v.name, v.valueReference, v.causality, v.variability, v.start) for v in three.modelVariables[:-1]] == rows
     assert [kinds[v.type] for v in two.modelVariables] == [v.type for v in three.modelVariables[:-1]]
+    items = [[(i.name, i.value) for i in v.declaredType.items] if v.type == "Enumeration" else None
+             for v in two.modelVariables]
+    assert [[(i.name, i.value) for i in v.declaredType.items] if v.type == "Enumeration" else None
+            for v in three.modelVariables[:-1]] == items
     time = three.modelVariables[-1]
     assert (time.name, time.causality, time.valueReference) == ("time", "independent", len(rows))
 
@@ -105,8 +120,7 @@ def _refusal(fmu, parameters) -> str:
     slave.setupExperiment(startTime=0.0)
     slave.enterInitializationMode()
     for name, value in parameters.items():
-        setter = {"String": slave.setString, "Integer": slave.setInteger, "Real": slave.setReal}[variables[name].type]
-        setter([variables[name].valueReference], [value])
+        set_value(slave, variables[name], value)
     with pytest.raises(FMICallException):
         slave.exitInitializationMode()
     slave.freeInstance()
@@ -115,7 +129,6 @@ def _refusal(fmu, parameters) -> str:
 
 
 @pytest.mark.parametrize("fmu, parameters", [
-    ("MotionProfile", {"profile": "nowhere"}),
     ("MotionProfile", {"profile": "coning", "coning_rate": math.inf}),
     ("MotionProfile", {"profile": "human", "human_omega_c": 0.0}),
     ("MotionProfile", {"profile": "human", "seed": -1}),
@@ -136,17 +149,32 @@ def test_the_native_sensor_refuses_a_latency_longer_than_its_delay_line_at_the_f
     assert "latency 11.0 s at 100.0 Hz is longer than the delay line's 1021 samples" in capsys.readouterr().out
 
 
-def _fmi3_run(fmu, parameters, inputs, h):
-    """The FMI 3.0 estimator under fmpy: outputs and valid per step, then the time it reports."""
+def _fmi3_slave(fmu, parameters):
+    """An FMI 3.0 FMU under fmpy, initialised with parameters (Float64, Int32, or Enumeration by
+    item name, set with fmi3SetInt64 as FMI 3.0 sets Enumerations): (slave, value references,
+    its folder)."""
     md = read_model_description(str(fmu))
-    variables = {v.name: v.valueReference for v in md.modelVariables}
     unzipped = extract(str(fmu))
-    slave = FMU3Slave(guid=md.guid, unzipDirectory=unzipped, modelIdentifier="AttitudeEstimator", instanceName="e3")
+    slave = FMU3Slave(guid=md.guid, unzipDirectory=unzipped, modelIdentifier=md.coSimulation.modelIdentifier,
+                      instanceName="three")
     slave.instantiate()
     slave.enterInitializationMode(startTime=0.0)
-    for name, value in parameters.items():
-        (slave.setString if isinstance(value, str) else slave.setFloat64)([variables[name]], [value])
+    for v in md.modelVariables:
+        if v.name in parameters:
+            value = parameters[v.name]
+            if v.type == "Enumeration":
+                slave.setInt64([v.valueReference], [enumeration_value(v, value)])
+            elif v.type == "Int32":
+                slave.setInt32([v.valueReference], [value])
+            else:
+                slave.setFloat64([v.valueReference], [value])
     slave.exitInitializationMode()
+    return slave, {v.name: v.valueReference for v in md.modelVariables}, unzipped
+
+
+def _fmi3_run(fmu, parameters, inputs, h):
+    """The FMI 3.0 estimator under fmpy: outputs and valid per step, then the time it reports."""
+    slave, variables, unzipped = _fmi3_slave(fmu, parameters)
     vin, vout = [variables[n] for n in SENSOR_OUT], [variables[n] for n in ESTIMATOR_OUT]
     out, valid = np.empty((len(inputs), len(vout))), np.empty(len(inputs), dtype=bool)
     for k, row in enumerate(inputs):
@@ -190,6 +218,33 @@ def test_the_fmi3_estimator_equals_the_fmi2_one(fmu_dir, parameters):
     assert np.array_equal(again, three[at + 1])
 
 
+@pytest.mark.parametrize("name, parameters, inputs, outputs", [
+    ("MotionProfile", {"profile": "coning", "coning_rate": 0.7}, [], ["omega_x", "f_y", "m_z", "qt_w", "qt_z"]),
+    ("MotionProfile", {"profile": "human", "seed": 5}, [], ["omega_z", "f_x", "qt_x"]),
+    ("ImuSensor", {"delta_n": 0.002, "acc_offset_x": 0.1, "mag_noise": 0.3, "seed": 7}, SENSOR_IN, SENSOR_OUT),
+])
+def test_the_fmi3_sensor_and_motion_equal_the_fmi2_ones(fmu_dir, name, parameters, inputs, outputs):
+    """The FMI 3.0 MotionProfile (its profile an Enumeration set by fmi3SetInt64) and ImuSensor
+    under fmpy give the FMI 2.0 ones' outputs within 1e-12, step by step."""
+    data = np.random.default_rng(11).normal(size=(300, len(inputs))) + (9.81 if inputs else 0.0)
+    runner = FmuRunner(fmu_dir / "native" / f"{name}.fmu", parameters, inputs, outputs)
+    two = np.array([runner.step(row, 1 / FS)[0] for row in data]) if inputs else runner.run(np.empty((300, 0)),
+                                                                                            1 / FS)[0]
+    runner.close()
+    slave, variables, unzipped = _fmi3_slave(fmu_dir / "native" / "fmi3" / f"{name}.fmu", parameters)
+    three, t = np.empty_like(two), 0.0
+    for k, row in enumerate(data):
+        if inputs:
+            slave.setFloat64([variables[n] for n in inputs], list(row))
+        slave.doStep(currentCommunicationPoint=t, communicationStepSize=1 / FS)
+        t += 1 / FS  # as FmuRunner keeps time
+        three[k] = slave.getFloat64([variables[n] for n in outputs])
+    slave.terminate()
+    slave.freeInstance()
+    shutil.rmtree(unzipped, ignore_errors=True)
+    assert np.abs(three - two).max() <= 1e-12 and np.abs(two).max() > 0
+
+
 @pytest.mark.parametrize("profile, method", list(zip(verify_module.SCENARIOS, [*METHODS, *METHODS])))
 def test_the_native_and_the_pythonfmu_chains_agree_within_1e_9(fmu_dir, tmp_path, profile, method):
     """Every profile (each with another method): verify's configuration run for 6 s on each chain,
@@ -211,32 +266,6 @@ def test_the_c_stepping_loop_equals_the_python_one(fmu_dir, tmp_path, monkeypatc
     assert all(np.array_equal(fast[k], slow[k]) and fast[k].dtype == slow[k].dtype for k in fast)
 
 
-def test_attitude_ssp_files_run_in_libcosim_and_give_the_verify_figures(fmu_dir, tmp_path, monkeypatch, capsys):
-    """`attitude ssp --out DIR` writes one self-contained SSP per profile × method; libcosim
-    (CosimExecution.from_ssp_file) runs it unchanged, and its figures, with its estimate two
-    steps late (one per connection), are verify's for that configuration (240 s runs)."""
-    pytest.importorskip("libcosimpy")
-    from attitude_fmu.systems.cli.commands import main
-
-    monkeypatch.setitem(verify_module.SCENARIOS, "incline", verify_module.Scenario(240.0, "mean"))
-    monkeypatch.setitem(verify_module.SCENARIOS, "human", verify_module.Scenario(
-        240.0, "rms", dict(verify_module.SCENARIOS["human"].imu)))
-    args = ["--fmu-dir", str(fmu_dir), "--profile", "incline", "--profile", "human", "--method", "wiener"]
-    assert main(["ssp", "--out", str(tmp_path / "ssp"), *args]) == 0
-    written = capsys.readouterr().out.split()
-    assert [p.rsplit("/", 1)[1] for p in written] == ["incline_wiener.ssp", "human_wiener.ssp"]
-    assert main(["verify", "--json", "--workers", "1", *args]) == 0  # in this process, where the 240 s runs are
-    rows = json.loads(capsys.readouterr().out)["rows"]
-    for path, row in zip(written, rows):
-        profile = row["profile"]
-        out = cosimulate_libcosim(path, verify_module.SCENARIOS[profile].duration, verify_module.STEP_S)
-        theirs = verify_module.row_of(out, profile, "wiener", lag=2)
-        assert row["chain"] == "native" and theirs["pass"] and row["pass"]
-        assert theirs["rms_deg"] == pytest.approx(row["rms_deg"], rel=1e-3)
-        assert theirs["max_deg"] == pytest.approx(row["max_deg"], rel=0.05)
-        assert theirs["mean_deg"] == pytest.approx(row["mean_deg"], rel=1e-3, abs=1e-6)
-
-
 def test_fmpy_reads_the_ssp_but_runs_it_without_its_parameters(fmu_dir, tmp_path):
     """fmpy's SSP reader takes the file as it is (components, sources, connections, parameter
     bindings); its simulate_ssp runs it but leaves the SSD's bindings out (docs/guide/fmus.md):
@@ -251,7 +280,8 @@ def test_fmpy_reads_the_ssp_but_runs_it_without_its_parameters(fmu_dir, tmp_path
     assert len(ssd.system.connections) == 18
     bound = {(e.name, p.name): p.value for e in ssd.system.elements for b in e.parameterBindings
              for s in b.parameterValues for p in s.parameters}
-    assert bound[("motion", "profile")] == "incline" and bound[("estimator", "Ts")] == "0.02"
+    profile = next(v for v in motion_profile() if v.name == "profile")
+    assert bound[("motion", "profile")] == str(item_value(profile, "incline")) and bound[("estimator", "Ts")] == "0.02"
     result = simulate_ssp(str(path), stop_time=1.0, step_size=verify_module.STEP_S)
     assert len(result) == 50 and np.abs(result["motion.omega_x"]).max() > 0  # incline does not rotate: human ran
 

@@ -26,7 +26,7 @@ from fmpy.validation import validate_fmu
 from attitude_fmu.blocks.methods.registry import METHODS
 from attitude_fmu.blocks.pipeline.causal import MAX_ACC_M_S2, MAX_GYR_RAD_S, valid_sample
 from attitude_fmu.blocks.pipeline.online import OnlineEstimator
-from attitude_fmu.blocks.stages.timing import same_step
+from attitude_fmu.fmu_src.variables import ENUMERATION, attitude_estimator
 from attitude_fmu.systems.fmi import native
 from attitude_fmu.systems.fmi.build import build_fmus
 from attitude_fmu.systems.fmi.cosim import cosimulate_libcosim
@@ -75,20 +75,19 @@ def stream(duration: float = 13.0, fast: float = 10.0, delay: int = 4):
 def reference(config: dict, rows, params=None):
     """blocks.pipeline.online's step on the rows with the FMU's configuration: the outputs
     (held where a sample is not taken), valid, and the status the FMU returns (1: a warning for
-    an input not taken that is invalid, or for the first step size other than TS)."""
+    an input not taken that is invalid; a step size other than TS is re-discretised, with
+    fmi2OK)."""
     est = OnlineEstimator(config["method"], params, heading=config["heading"] == "mag",
                           gyro_offset=config["gyro_offset"] == "on", latency=config["latency"],
                           gyr_samples=config["gyr_samples"], acc_samples=config["acc_samples"])
     out, valid, status = np.empty((len(rows), len(OUTPUTS))), np.empty(len(rows), bool), np.zeros(len(rows))
-    last, warned = START, False
+    last = START
     for k, (_, h, *u) in enumerate(rows):
         valid[k] = est.step(u[0:3], u[3:6], h, u[6:9])
         if valid[k]:
             last = np.r_[est.quat, est.up, est.euler, est.offset, est.mag_offset, est.mag_delay]
         elif not valid_sample(u[0:3], u[3:6]):
             status[k] = 1
-        if not warned and not same_step(h, TS):
-            warned, status[k] = True, 1
         out[k] = last
     return out, valid, status
 
@@ -164,12 +163,13 @@ def run_script(runner, lines, folder, sanitized=False):
 def configure(vr, config, params=None):
     """Runner lines: back to the start, the configuration's parameters, initialised."""
     lines = ["reset", "setup", "enter"]
-    lines += [f"string {vr[k]} {config[k]}" for k in STRINGS]
+    lines += [f"integer {vr[k]} {ITEMS[k].index(config[k]) + 1}" for k in ITEMS]
     lines += [f"real {vr[name]} {value!r}" for name, value in {"latency": config["latency"], **(params or {})}.items()]
     return lines + ["exit"]
 
 
-STRINGS = ("method", "heading", "gyro_offset", "gyr_samples", "acc_samples")
+# the choices (Enumerations): their item names, of the values 1, 2, ...
+ITEMS = {v.name: v.items for v in attitude_estimator() if v.type == ENUMERATION}
 
 
 def initialise(fmu, vr, config):
@@ -177,7 +177,7 @@ def initialise(fmu, vr, config):
     fmu.reset()
     fmu.setupExperiment(startTime=0.0)
     fmu.enterInitializationMode()
-    fmu.setString([vr[k] for k in STRINGS], [config[k] for k in STRINGS])
+    fmu.setInteger([vr[k] for k in ITEMS], [ITEMS[k].index(config[k]) + 1 for k in ITEMS])
     fmu.setReal([vr["latency"]], [config["latency"]])
     fmu.exitInitializationMode()
 
@@ -230,6 +230,7 @@ def test_every_configuration_in_a_c_host_equals_the_python_step(runner, unzipped
     for k in BAD_ROWS:  # held, not valid, a warning; taken again on the next sample
         assert not valid[k] and status[k] == 1 and np.array_equal(out[k], out[k - 1]) and valid[k + 1]
     assert not valid[:3].any() and not status[:3].any()  # no accelerometer yet: not started, no warning
+    assert set(np.flatnonzero(status)) == set(BAD_ROWS)  # the step size's change midway: fmi2OK
     assert np.abs(out[-1, 10:13]).max() > 0  # the gyro offset estimated
 
 
@@ -270,12 +271,12 @@ def robustness_script(md, vr, binary):
     call("reset", 0)
     call("setup", 0)
     call("enter", 0)
-    call(f"real {vr['method']} 1.0", 3)  # a Real set on a String
+    call(f"real {vr['method']} 1.0", 3)  # a Real set on an Enumeration
     initialised()
     call(f"real {vr['Ts']} 0.02", 3)  # a fixed parameter after initialisation
     initialised()
     call(f"real {vr['q_w']} 0.5", 3)  # an output after initialisation
-    initialised(f"string {vr['method']} mahony")
+    initialised(f"integer {vr['method']} {ITEMS['method'].index('mahony') + 1}")
     call(f"real {vr['gyr_x']} 0.1", 0)
     call("step 0 0.01", 0)
     call("save", 0)
@@ -290,26 +291,32 @@ def robustness_script(md, vr, binary):
         call("reset", 0)
         call("setup", 0)
         call("enter", 0)
-        call(f"{'string' if isinstance(value, str) else 'real'} {vr[name]} {value}", 0)
+        call(f"real {vr[name]} {value}", 0)
         call("exit", 3)
+    for name, value in OUT_OF_ITEMS:  # refused when set
+        call("reset", 0)
+        call("setup", 0)
+        call("enter", 0)
+        call(f"integer {vr[name]} {value}", 3)
     call("free", 0)
     call(f"cycles 1000 {guid} {uri} 0.01", 0)
     steps.append("unload")
     return steps, expected
 
 
-INVALID = [("delta_n", -1.0), ("delta_n", math.inf), ("delta_v", -math.inf), ("delta_n", 1e300), ("method", "kalman"),
-           ("Ts", 0.0), ("heading", "compass"), ("gyro_offset", "maybe"), ("gyr_samples", "sometimes"),
+INVALID = [("delta_n", -1.0), ("delta_n", math.inf), ("delta_v", -math.inf), ("delta_n", 1e300), ("Ts", 0.0),
            ("latency", 5.0), ("k_P", 2.0), ("tau_heading", -3.0)]
+OUT_OF_ITEMS = [("method", 7), ("method", 0), ("heading", 3), ("gyro_offset", -1), ("gyr_samples", 2**31 - 1)]
 
 
 def test_wrong_calls_and_invalid_parameters_end_in_fmi2_error_with_a_message(runner, unzipped, md, vr, tmp_path):
     """A C host with no Python: doStep before initialisation and after fmi2Terminate, a Real set
-    on a String, a fixed parameter or an output set after initialisation, and invalid parameters
-    (negative or non-finite densities, values beyond their plausible range such as 1e300, an
-    unknown method, out-of-range settings) end in fmi2Error with a log message, as
-    blocks.pipeline.online words its refusals; fmi2Reset leads on. A state saved and restored
-    steps on as before; 1000 instantiate → step → terminate → free cycles, then main returns 0."""
+    on an Enumeration, a fixed parameter or an output set after initialisation, and invalid
+    parameters (negative or non-finite densities, values beyond their plausible range such as
+    1e300, a choice none of whose items has the value) end in fmi2Error with a log message, as
+    blocks.pipeline.online words its refusals (a choice's: naming the items); fmi2Reset leads on.
+    A state saved and restored steps on as before; 1000 instantiate → step → terminate → free
+    cycles, then main returns 0."""
     binary = unzipped / native.binary_path("AttitudeEstimator")
     script, expected = robustness_script(md, vr, binary)
     lines, _, log = run_script(runner["plain"], script, tmp_path)
@@ -318,16 +325,18 @@ def test_wrong_calls_and_invalid_parameters_end_in_fmi2_error_with_a_message(run
     assert first == second
     for text in ("fmi2DoStep is not allowed in the state instantiated", "fmi2DoStep is not allowed in the state terminated",
                  "fmi2ExitInitializationMode is not allowed in the state instantiated",
-                 f"value reference {vr['method']} is method, a String variable", "Ts is a fixed parameter",
+                 f"value reference {vr['method']} is method, an Enumeration variable", "Ts is a fixed parameter",
                  "q_w is a continuous output", "invalid parameter: Ts must be a finite positive number of seconds, got 0.0",
-                 "invalid parameter: heading must be 'mag' or 'gyro', got 'compass'",
-                 "invalid parameter: gyro_offset must be 'on' or 'off', got 'maybe'"):
+                 "fmi2SetInteger: method must be one of its items (1 wiener, 2 tseng, 3 tseng_adaptive, 4 luinge, "
+                 "5 mahony, 6 first_order), got 7",
+                 "fmi2SetInteger: heading must be one of its items (1 mag, 2 gyro), got 3"):
         assert text in log, text
+    assert log.count("must be one of its items") == len(OUT_OF_ITEMS)
     for name, value in INVALID:
-        if name in ("Ts", "heading", "gyro_offset"):  # the FMU's own checks
+        if name == "Ts":  # the FMU's own check
             continue
         given = dict(method="wiener", params=None, heading=True, gyro_offset=True)  # the FMU's defaults
-        given.update({name: value} if name in ("method", "gyr_samples", "latency") else {"params": {name: value}})
+        given.update({name: value} if name == "latency" else {"params": {name: value}})
         with pytest.raises(ValueError) as refusal:
             OnlineEstimator(**given)
         assert f"invalid parameter: {refusal.value}" in log, name
@@ -508,18 +517,19 @@ def test_fmpy_compiles_the_source_fmu_into_a_working_binary(fmus, md, vr, rows, 
 def test_libcosim_runs_an_ssp_with_the_native_estimator_and_it_computes_the_python_step(fmu_dir, tmp_path):
     """libcosim (its own SSP reader, FMI Library, master) runs the diagram with the native
     estimator beside the pythonfmu one: its outputs, on the inputs libcosim handed it, are
-    blocks.pipeline.online's within 1e-9, and equal the pythonfmu estimator's."""
+    blocks.pipeline.online's within 1e-9, and equal the pythonfmu estimator's. libcosim ignores
+    FMI Enumeration variables (it warns): the choices stay at their start values here."""
     pytest.importorskip("libcosimpy")
     ssp = write_ssp(tmp_path / "human.ssp", fmu_dir, {
-        "motion": {"profile": "human", "seed": 3},
+        "motion": {"seed": 3},
         "imu": {"delta_n": math.radians(0.1), "seed": 4, "gyr_offset_z": 0.01, "mag_noise": 0.2, "mag_offset_x": 9.0},
-        "estimator": {"method": "tseng_adaptive", "gyr_samples": "point", "latency": 0.004}}, 8.0, TS, native=True)
+        "estimator": {"tau_heading": 2.0, "latency": 0.004}}, 8.0, TS, native=True)
     out = cosimulate_libcosim(ssp, 8.0, TS)
     received = np.column_stack([out[f"native.{n}"] for n in INPUTS])
-    config = {"method": "tseng_adaptive", "heading": "mag", "gyro_offset": "on", "gyr_samples": "point",
+    config = {"method": "wiener", "heading": "mag", "gyro_offset": "on", "gyr_samples": "mean",
               "acc_samples": "point", "latency": 0.004}
     ref, valid, _ = reference(config, np.column_stack([np.arange(len(received)) * TS, np.full(len(received), TS),
-                                                       received]))
+                                                       received]), {"tau_heading": 2.0})
     assert np.array_equal(out["native.valid"], valid) and valid[5:].all()
     estimated = np.column_stack([out[f"native.{n}"] for n in OUTPUTS])
     assert np.abs(estimated - ref).max() < 1e-9

@@ -1,7 +1,8 @@
 """The simulation (systems/simulation/core through the public API) against independent truth:
 the noise streams are Box–Muller of numpy's Philox4x64-10 blocks; the closed-form profiles
 are their formulas, evaluated here with scipy's Rotation; the human motion is the exact
-Ornstein–Uhlenbeck recursion of its docstring driven by the stream MOTION; the sensor is
+Ornstein–Uhlenbeck recursion of its docstring driven by the stream MOTION, a step per cell of its
+grid, sampled by composing the cells' turns and velocity changes; the sensor is
 Rizun's eqs. 1–2 with the streams SENSOR and MAGNETOMETER and a linear-interpolating delay
 line; the noise densities measured over a long run are the parameters; refusals keep their
 words."""
@@ -190,16 +191,72 @@ def test_the_human_motion_is_the_ou_recursion_of_its_noise_stream(motion, seed):
 
 
 @pytest.mark.parametrize("values, message", [
-    ({"delta_v": 0.0}, "delta_v must be a finite positive number, got 0.0"),
-    ({"omega_c": math.nan}, "omega_c must be a finite positive number, got nan"),
-    ({"rot_cutoff": -1.0}, "rot_cutoff must be a finite positive number, got -1.0"),
-    ({"g": math.inf}, "g must be a finite positive number, got inf"),
-    ({"rot_rms": -0.5}, "rot_rms must be finite and non-negative, got -0.5"),
+    ({"delta_v": -1.0}, "parameter human_delta_v = -1.0 m/s/√Hz is outside its plausible range [0, 100] m/s/√Hz"),
+    ({"omega_c": math.nan}, "parameter human_omega_c = nan rad/s is outside its plausible range [0.0001, 100000] rad/s"),
+    ({"rot_cutoff": -1.0}, "parameter human_rot_cutoff = -1.0 rad/s is outside its plausible range [0.0001, 100000] "
+                           "rad/s"),
+    ({"g": math.inf}, "parameter g = inf m/s^2 is outside its plausible range [1, 30] m/s^2"),
+    ({"rot_rms": -0.5}, "parameter human_rot_rms = -0.5 rad/s is outside its plausible range [0, 69.8132] rad/s"),
+    ({"grid": 0.0}, "parameter human_grid = 0.0 s is outside its plausible range [1e-06, 1] s"),
 ])
 def test_the_human_motion_refuses_bad_parameters_in_its_words(values, message):
     with pytest.raises(ValueError) as refused:
         HumanMotion(**{"delta_v": 1.0, "omega_c": 10.0, "rot_rms": 1.0, "rot_cutoff": 5.0, "g": 9.81, **values})
     assert str(refused.value) == message
+
+
+@pytest.mark.parametrize("cells", [1, 5])
+def test_the_human_motion_on_its_grid_is_the_ou_recursion_per_cell_sampled(cells):
+    """On a grid of G = Ts/cells: v_j = φ_v·v_{j−1} + σ_v·z_j[0:3], ω_j = φ_w·ω_{j−1} + σ_w·z_j[3:6] per
+    cell j (z the stream MOTION, φ and σ for G), the orientation turned by ω_j·G over cell j; the samples
+    over (t[k−1], t[k]]: quat the orientation at t[k], gyr the rotation vector of the turn over the
+    interval over Ts, the earth-frame specific force less g the velocity's change over Ts."""
+    motion, seed, n = HumanMotion(0.4, 6.0, 2.5, 9.0, G, grid=1.0 / (FS * cells)), 7, 400
+    run = motion.generate(n / FS, FS, seed)
+    grid, z = motion.grid, normals(seed, MOTION, n * cells)
+    phi_v, phi_w = math.exp(-motion.omega_c * grid), math.exp(-motion.rot_cutoff * grid)
+    sigma_v = math.sqrt(motion.delta_v**2 * motion.omega_c / 4.0 * (1.0 - phi_v**2))
+    sigma_w = math.sqrt(motion.rot_rms**2 * (1.0 - phi_w**2))
+    v, w = np.zeros((n * cells + 1, 3)), np.zeros((n * cells + 1, 3))
+    for j in range(n * cells):
+        v[j + 1] = phi_v * v[j] + sigma_v * z[j, 0:3]
+        w[j + 1] = phi_w * w[j] + sigma_w * z[j, 3:6]
+    turns = Rotation.from_rotvec(w[1:] * grid)
+    orientation = [Rotation.identity()]
+    for turn in turns:
+        orientation.append(orientation[-1] * turn)
+    truth = Rotation.concatenate(orientation[cells::cells])
+    assert _same_rotations(run.quat, truth.as_quat(scalar_first=True)) < 1e-12
+    before = Rotation.concatenate([Rotation.identity(), truth[:-1]])
+    assert np.abs(run.gyr - (before.inv() * truth).as_rotvec() * FS).max() < 1e-10
+    acc = Rotation.from_quat(run.quat, scalar_first=True).apply(run.acc) - [0.0, 0.0, G]
+    assert np.abs(acc - np.diff(v[::cells], axis=0) * FS).max() < 1e-9
+
+
+def test_the_human_motion_with_a_cell_per_sample_is_the_same_on_a_grid_of_the_sample_time():
+    """grid None (a cell per sample, the batch's) and grid 1/fs: one process (to the rounding of the
+    sample times k/fs against the cells' ends k·grid)."""
+    motion = HumanMotion(0.4, 6.0, 2.5, 9.0, G)
+    a, b = motion.generate(30.0, FS, 5), HumanMotion(0.4, 6.0, 2.5, 9.0, G, grid=1.0 / FS).generate(30.0, FS, 5)
+    assert _same_rotations(a.quat, b.quat) < 1e-13
+    assert np.abs(a.gyr - b.gyr).max() < 1e-10 and np.abs(a.acc - b.acc).max() < 1e-10 * np.abs(a.acc).max()
+
+
+@pytest.mark.parametrize("name", sorted(PROFILES))
+@pytest.mark.parametrize("edge", ["low", "high"])
+def test_every_profile_at_the_edges_of_its_ranges_gives_finite_samples_for_a_long_time(name, edge):
+    """Every parameter at the low (high) end of its plausible range at once, g too; samples up to
+    10⁶ s (the step levels of step_rotation, the turns of the rotations): finite, unit quaternions."""
+    params = {p.name: getattr(p, edge) for p in PROFILES[name].params}
+    motion = profile(name).motion(params, g=1.0 if edge == "low" else 30.0)
+    if name == "human":
+        stream = motion.stream(2)
+        rows = [np.concatenate(stream.step(t, 1e-3)) for t in (1e-3, 0.5, 2.0, 2.5)]
+    else:
+        rows = [np.concatenate(sample, axis=1) for sample in [motion.at([0.01, 1.0, 1e3, 1e6], 1e-3)]][0]
+    rows = np.array(rows)
+    assert np.isfinite(rows).all(), rows
+    assert np.abs(np.linalg.norm(rows[:, 6:10], axis=1) - 1.0).max() < 1e-9
 
 
 # ---- the sensor: Rizun's eqs. 1–2, the noise streams, a delay line
@@ -288,7 +345,7 @@ def test_the_noise_densities_measured_over_a_long_run_are_the_parameters():
     of density·√fs instead of density·√(fs/2) is 41 % off), its mean the offset."""
     imu = ImuModel(delta_n=math.radians(0.1), acc_noise=0.02, mag_noise=0.3, gyr_offset=(0.01, 0.0, 0.0),
                    mag_offset=(5.0, 0.0, -2.0))
-    motion = HumanMotion(delta_v=1e-12, rot_rms=0.0).generate(500.0, FS, seed=1)
+    motion = HumanMotion(delta_v=0.0, rot_rms=0.0).generate(500.0, FS, seed=1)
     gyr, acc = imu.apply(motion, seed=9)
     errors = (gyr - motion.gyr, acc - motion.acc, imu.apply_mag(motion, seed=9) - motion.mag)
     for error, density, offset in zip(errors, (imu.delta_n, imu.acc_noise, imu.mag_noise),

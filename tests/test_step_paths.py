@@ -16,6 +16,7 @@ from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 
 from attitude_fmu import OnlineEstimator, estimate, estimator_system
+from attitude_fmu.systems.fmi.cosim import set_value
 from tests import golden
 from tests.test_golden import FROZEN, assert_close
 
@@ -34,7 +35,7 @@ class Fmu:
         self.md = read_model_description(str(path))
         self.folder = extract(str(path), str(folder))
         self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
-        self.types = {v.name: v.type for v in self.md.modelVariables}
+        self.variables = {v.name: v for v in self.md.modelVariables}
 
     def run(self, start: dict, gyr, acc, mag, Ts):
         """The outputs after each step (N×17) and valid (N), each step as long as its Ts."""
@@ -44,7 +45,7 @@ class Fmu:
         fmu.setupExperiment(startTime=0.0)
         fmu.enterInitializationMode()
         for name, value in start.items():
-            (fmu.setString if self.types[name] == "String" else fmu.setReal)([self.vr[name]], [value])
+            set_value(fmu, self.variables[name], value)
         fmu.exitInitializationMode()
         vin, vout, valid_vr = [self.vr[n] for n in INPUTS], [self.vr[n] for n in OUTPUTS], [self.vr["valid"]]
         out, valid, t = np.empty((len(gyr), len(OUTPUTS))), np.empty(len(gyr), dtype=bool), 0.0

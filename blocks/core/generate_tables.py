@@ -1,14 +1,18 @@
-"""The C header of the core's parameter tables, written by the build from the Python table
-(blocks/tuning.py) so that they cannot drift: every tuning parameter's name and index (in the
-order of blocks.tuning.uses, the estimator FMU's variables'), each stage's parameters
-field by field as blocks.params.Param holds them (default NaN where Python's is None, the
-plausible range low and high, choices as a static array or NULL; CField).
+"""The C headers of the parameter tables, written by the build from the Python tables so that
+they cannot drift, each parameter field by field as blocks.params.Param holds it (default NaN
+where Python's is None, the plausible range low and high, choices as a static array or NULL;
+CField):
 
-    python blocks/core/generate_tables.py DIR    # writes DIR/af_params.h (CMake runs it)
+- af_params.h, the estimator's (blocks/tuning.py): every tuning parameter's name and index (in
+  the order of blocks.tuning.uses, the estimator FMU's variables'), each stage's parameters;
+- sim_profiles.h, the simulation's (systems/simulation/profile_table.py): every motion profile's
+  name, summary and parameters, and gravity's.
+
+    python blocks/core/generate_tables.py DIR    # writes DIR/af_params.h, DIR/sim_profiles.h (CMake runs it)
 
 Only the standard library is needed: the package's folder is loaded as attitude_fmu without
-its dependencies. The header is generated into the build folder, never committed; the C core
-(blocks/core) includes it as "af_params.h".
+its dependencies. The headers are generated into the build folder, never committed; the C core
+(blocks/core) includes "af_params.h", the simulation's (systems/simulation/core) "sim_profiles.h".
 """
 from __future__ import annotations
 
@@ -28,8 +32,10 @@ if __package__ in (None, ""):  # run as a script by the build: this clone's fold
 
 from attitude_fmu.blocks.params import Param  # noqa: E402
 from attitude_fmu.blocks.tuning import ESTIMATORS, METHODS, uses  # noqa: E402
+from attitude_fmu.systems.simulation.profile_table import GRAVITY, PROFILES  # noqa: E402
 
 HEADER = "af_params.h"
+PROFILES_HEADER = "sim_profiles.h"
 ESTIMATOR_STAGES = ("gyro_offset", "heading")  # the C names of blocks.pipeline.causal.ESTIMATORS, in its order
 C_TYPES = {"str": "const char *", "float": "double", "bool": "int", "int": "int"}  # of a Param field's values
 NONE_IN_C = {"float": "NAN", "str": "NULL"}  # None as an optional field's C value (where its type has one)
@@ -148,8 +154,28 @@ def _param_fields() -> list[CField]:
 
 def _identifier(name: str) -> str:
     if not name.isidentifier() or not name.isascii():
-        raise ValueError(f"parameter or stage name {name!r} is not a C identifier")
+        raise ValueError(f"parameter, stage or profile name {name!r} is not a C identifier")
     return name
+
+
+def _param_struct(type_name: str, leading: list[str], fields: list[CField]) -> list[str]:
+    """The typedef of type_name: the leading members, then every field's (CField.members)."""
+    members = leading + [member for field in fields for member in field.members()]
+    return ["typedef struct {", *(f"    {member}" for member in members), f"}} {type_name};"]
+
+
+def _param_table(array: str, type_name: str, params, fields: list[CField], leading=lambda p: []) -> list[str]:
+    """static const type_name array[] with every Param of params, its leading values (leading(p))
+    then its fields', after the static arrays of its sequences (array_<param>_<field>)."""
+    names = {(p.name, f.name): f"{array}_{p.name}_{f.name}" for p in params for f in fields}
+    lines = [text for p in params for f in fields
+             if (text := f.array(getattr(p, f.name), names[p.name, f.name])) is not None]
+    lines.append(f"static const {type_name} {array}[{len(params)}] = {{")
+    for p in params:
+        values = leading(p) + [f.initialiser(getattr(p, f.name), names[p.name, f.name]) for f in fields]
+        lines.append(f"    {{{', '.join(values)}}},")
+    lines.append("};")
+    return lines
 
 
 def header_text() -> str:
@@ -193,10 +219,7 @@ def header_text() -> str:
         "/* One parameter of a stage, field by field as blocks.params.Param (NaN where its default is",
         " * None; a tuple as its values and their count n_<name>, NULL where None), with its index",
         " * into the AF_N_PARAMS values. */",
-        "typedef struct {",
-        "    int index;",
-        *(f"    {member}" for field in fields for member in field.members()),
-        "} AfStageParam;",
+        *_param_struct("AfStageParam", ["int index;"], fields),
         "",
         "typedef struct {",
         "    const char *name;  /* the method's name, or the estimator's C name */",
@@ -208,16 +231,9 @@ def header_text() -> str:
         "",
     ]
     for name, _, _, stage_params in all_stages:
-        if not stage_params:
-            continue
-        arrays = {(p.name, f.name): f"AF_STAGE_PARAMS_{name}_{p.name}_{f.name}" for p in stage_params for f in fields}
-        lines += [text for p in stage_params for f in fields
-                  if (text := f.array(getattr(p, f.name), arrays[p.name, f.name])) is not None]
-        lines.append(f"static const AfStageParam AF_STAGE_PARAMS_{name}[{len(stage_params)}] = {{")
-        for p in stage_params:
-            values = ", ".join(f.initialiser(getattr(p, f.name), arrays[p.name, f.name]) for f in fields)
-            lines.append(f"    {{AF_P_{p.name}, {values}}},")
-        lines.append("};")
+        if stage_params:
+            lines += _param_table(f"AF_STAGE_PARAMS_{name}", "AfStageParam", stage_params, fields,
+                                  lambda p: [f"AF_P_{p.name}"])
     lines += [
         "",
         "static const AfStage AF_STAGES[AF_N_STAGES] = {",
@@ -234,16 +250,65 @@ def header_text() -> str:
     return "\n".join(lines)
 
 
-def write_headers(folder) -> Path:
-    """af_params.h written into folder (created if missing); returns its path."""
+def profiles_text() -> str:
+    """The text of sim_profiles.h."""
+    fields = _param_fields()
+    lines = [
+        "/* sim_profiles.h: generated by blocks/core/generate_tables.py from the Python table",
+        " * (systems/simulation/profile_table.py: PROFILES, GRAVITY; blocks.params.Param).",
+        " * Do not edit: generate it again. */",
+        "#ifndef SIM_PROFILES_H",
+        "#define SIM_PROFILES_H",
+        "",
+        "#include <math.h>   /* NAN */",
+        "#include <stddef.h> /* NULL */",
+        "",
+        "/* The motion profiles, in the order of profile_table.py's PROFILES, and the most parameters one takes. */",
+        f"#define SIM_N_PROFILES {len(PROFILES)}",
+        f"#define SIM_PROFILE_MAX_PARAMS {max(len(params) for _, params in PROFILES.values())}",
+        "",
+        "/* One parameter of a profile, field by field as blocks.params.Param (NaN where its default is None; a",
+        " * tuple as its values and their count n_<name>, NULL where None). */",
+        *_param_struct("SimProfileParam", [], fields),
+        "",
+        "typedef struct {",
+        "    const char *name;    /* the profile's, MotionProfile.fmu's value of profile */",
+        "    const char *summary;",
+        "    int n_params;",
+        "    const SimProfileParam *params; /* in the order the profile takes them */",
+        "} SimProfile;",
+        "",
+    ]
+    for name, (_, params) in PROFILES.items():
+        lines += _param_table(f"SIM_PROFILE_PARAMS_{_identifier(name)}", "SimProfileParam", params, fields)
+    lines += [
+        "",
+        "static const SimProfile SIM_PROFILES[SIM_N_PROFILES] = {",
+        *(f"    {{{c_string(name)}, {c_string(summary)}, {len(params)}, SIM_PROFILE_PARAMS_{name}}},"
+          for name, (summary, params) in PROFILES.items()),
+        "};",
+        "",
+        "/* gravity g, every profile's (m/s^2) */",
+        *_param_table("SIM_PROFILE_GRAVITY", "SimProfileParam", (GRAVITY,), fields),
+        "",
+        "#endif",
+        "",
+    ]
+    return "\n".join(lines)
+
+
+def write_headers(folder) -> list[Path]:
+    """af_params.h and sim_profiles.h written into folder (created if missing); returns their paths."""
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
-    path = folder / HEADER
-    path.write_text(header_text(), encoding="ascii")
-    return path
+    paths = []
+    for name, text in ((HEADER, header_text()), (PROFILES_HEADER, profiles_text())):
+        paths.append(folder / name)
+        paths[-1].write_text(text, encoding="ascii")
+    return paths
 
 
 if __name__ == "__main__":
     if len(sys.argv) != 2:
         sys.exit("usage: python blocks/core/generate_tables.py DIR")
-    print(write_headers(sys.argv[1]))
+    print(*write_headers(sys.argv[1]), sep="\n")

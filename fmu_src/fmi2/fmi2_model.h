@@ -16,7 +16,8 @@
 
 #include "fmi2Functions.h"
 
-typedef enum { FMI2_REAL, FMI2_INTEGER, FMI2_BOOLEAN, FMI2_STRING } Fmi2Type;
+/* An Enumeration's value is an fmi2Integer (1 ... its number of items), held among the integers. */
+typedef enum { FMI2_REAL, FMI2_INTEGER, FMI2_BOOLEAN, FMI2_STRING, FMI2_ENUMERATION } Fmi2Type;
 typedef enum { FMI2_PARAMETER, FMI2_CALCULATED_PARAMETER, FMI2_INPUT, FMI2_OUTPUT, FMI2_LOCAL, FMI2_INDEPENDENT }
     Fmi2Causality;
 typedef enum { FMI2_CONSTANT, FMI2_FIXED, FMI2_TUNABLE, FMI2_DISCRETE, FMI2_CONTINUOUS } Fmi2Variability;
@@ -32,9 +33,12 @@ typedef struct {
     Fmi2Causality causality;
     Fmi2Variability variability;
     Fmi2Initial initial;
-    size_t index;             /* its place among the values of its type (Fmi2Instance.reals, ...) */
-    double start;             /* the start value of a Real, Integer (whole) or Boolean (0 or 1) */
+    size_t index;             /* its place among the values of its type (Fmi2Instance.reals, ...; an
+                                 Enumeration's among the integers) */
+    double start;             /* the start value of a Real, Integer or Enumeration (whole) or Boolean (0 or 1) */
     const char *start_string; /* the start value of a String; NULL for the other types */
+    const char *const *items; /* an Enumeration's item names, of the values 1 ... n_items; NULL for the others */
+    size_t n_items;
 } Fmi2Variable;
 
 typedef struct Fmi2Instance Fmi2Instance;
@@ -85,5 +89,10 @@ void fmi2_log(Fmi2Instance *instance, fmi2Status status, const char *format, ...
     __attribute__((format(printf, 3, 4)))
 #endif
     ;
+
+/* The item name of the value of the Enumeration held at integers[index], or NULL with an error logged
+ * if the value is none of its items' (sets are checked: a restored FMU state is not) or no Enumeration
+ * is held there. */
+const char *fmi2_item(Fmi2Instance *instance, size_t index);
 
 #endif

@@ -117,8 +117,8 @@ fmi2Status fmi2_serialize(Fmi2Instance *instance, fmi2FMUstate state, fmi2Byte b
         return fmi2Error;
     }
     if (!bytes || size != sizeof(Header) + instance->data_size) {
-        fmi2_log(instance, fmi2Error, "fmi2SerializeFMUstate: %zu bytes given, the state takes %zu", size,
-                 sizeof(Header) + instance->data_size);
+        fmi2_log(instance, fmi2Error, "fmi2SerializeFMUstate: %lu bytes given, the state takes %lu",
+                 (unsigned long)size, (unsigned long)(sizeof(Header) + instance->data_size));
         return fmi2Error;
     }
     memcpy(bytes, &s->header, sizeof s->header);

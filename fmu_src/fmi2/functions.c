@@ -109,19 +109,19 @@ fmi2Status fmi2CancelStep(fmi2Component c) {
 }
 
 /* fmi2Get* and fmi2Set* of each type */
-#define GET_SET(Type, TYPE, type)                                                                                  \
+#define GET_SET(Type, TYPES, type)                                                                                 \
     fmi2Status fmi2Get##Type(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, type value[]) {            \
         INSTANCE(c, "fmi2Get" #Type, GETTABLE);                                                                    \
-        return fmi2_leave(instance, fmi2_get_values(instance, "fmi2Get" #Type, TYPE, vr, nvr, value));             \
+        return fmi2_leave(instance, fmi2_get_values(instance, "fmi2Get" #Type, TYPES, vr, nvr, value));            \
     }                                                                                                              \
     fmi2Status fmi2Set##Type(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const type value[]) {      \
         INSTANCE(c, "fmi2Set" #Type, SETTABLE);                                                                    \
-        return fmi2_leave(instance, fmi2_set_values(instance, "fmi2Set" #Type, TYPE, vr, nvr, value));             \
+        return fmi2_leave(instance, fmi2_set_values(instance, "fmi2Set" #Type, TYPES, vr, nvr, value));            \
     }
-GET_SET(Real, FMI2_REAL, fmi2Real)
-GET_SET(Integer, FMI2_INTEGER, fmi2Integer)
-GET_SET(Boolean, FMI2_BOOLEAN, fmi2Boolean)
-GET_SET(String, FMI2_STRING, fmi2String)
+GET_SET(Real, FMI2_TYPES(FMI2_REAL), fmi2Real)
+GET_SET(Integer, FMI2_INTEGERS, fmi2Integer)
+GET_SET(Boolean, FMI2_TYPES(FMI2_BOOLEAN), fmi2Boolean)
+GET_SET(String, FMI2_TYPES(FMI2_STRING), fmi2String)
 #undef GET_SET
 
 fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate) {

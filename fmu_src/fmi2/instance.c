@@ -113,7 +113,8 @@ void fmi2_instance_reset(Fmi2Instance *instance) {
         const Fmi2Variable *v = &fmi2_model.variables[vr];
         switch (v->type) {
         case FMI2_REAL: instance->reals[v->index] = v->start; break;
-        case FMI2_INTEGER: instance->integers[v->index] = (fmi2Integer)v->start; break;
+        case FMI2_INTEGER:
+        case FMI2_ENUMERATION: instance->integers[v->index] = (fmi2Integer)v->start; break;
         case FMI2_BOOLEAN: instance->booleans[v->index] = v->start != 0.0; break;
         case FMI2_STRING:
             strncpy(instance->strings[v->index], v->start_string, FMI2_STRING_SIZE - 1);

@@ -3,8 +3,8 @@
  * (fmi2/instance.h: the states Instantiated, Initialization Mode, Step Mode (there "step
  * complete"), Terminated and the error state), does it through the plumbing, and returns the status
  * the standard gives it, raised to what the call logged. A call without an instance (NULL) returns
- * fmi3Error: there is no logger to tell. The variables are the model's (Float64, Int32, Boolean and
- * String: its Real, Integer, Boolean and String ones) and `time`, the independent variable. */
+ * fmi3Error: there is no logger to tell. The variables are the model's (Float64, Int32, Int64, Boolean and
+ * String: its Real, Integer, Enumeration, Boolean and String ones) and `time`, the independent variable. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -142,8 +142,8 @@ fmi3Status fmi3DoStep(fmi3Instance c, fmi3Float64 currentCommunicationPoint, fmi
 
 static int counts_match(Fmi2Instance *instance, const char *call, size_t nvr, size_t n_values) {
     if (nvr == n_values) return 1;
-    fmi2_log(instance, fmi2Error, "%s: %zu values for %zu value references (every variable here is a scalar)", call,
-             n_values, nvr);
+    fmi2_log(instance, fmi2Error, "%s: %lu values for %lu value references (every variable here is a scalar)", call,
+             (unsigned long)n_values, (unsigned long)nvr);
     return 0;
 }
 
@@ -153,7 +153,7 @@ fmi3Status fmi3GetFloat64(fmi3Instance c, const fmi3ValueReference vr[], size_t 
     if (!counts_match(instance, "fmi3GetFloat64", nvr, nValues)) return leave(instance, fmi2Error);
     for (size_t i = 0; i < nvr; i++) {
         if (vr[i] == FMI3_TIME_VR) values[i] = fmi3_context(instance)->time;
-        else if (fmi2_get_values(instance, "fmi3GetFloat64", FMI2_REAL, &vr[i], 1, &values[i]) != fmi2OK)
+        else if (fmi2_get_values(instance, "fmi3GetFloat64", FMI2_TYPES(FMI2_REAL), &vr[i], 1, &values[i]) != fmi2OK)
             return leave(instance, fmi2Error);
     }
     return leave(instance, fmi2OK);
@@ -168,33 +168,34 @@ fmi3Status fmi3SetFloat64(fmi3Instance c, const fmi3ValueReference vr[], size_t 
             fmi2_log(instance, fmi2Error, "fmi3SetFloat64: time is the independent variable: it cannot be set");
             return leave(instance, fmi2Error);
         }
-    return leave(instance, fmi2_set_values(instance, "fmi3SetFloat64", FMI2_REAL, vr, nvr, values));
+    return leave(instance, fmi2_set_values(instance, "fmi3SetFloat64", FMI2_TYPES(FMI2_REAL), vr, nvr, values));
 }
 
 fmi3Status fmi3GetString(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, fmi3String values[],
                          size_t nValues) {
     INSTANCE(c, "fmi3GetString", GETTABLE);
     if (!counts_match(instance, "fmi3GetString", nvr, nValues)) return leave(instance, fmi2Error);
-    return leave(instance, fmi2_get_values(instance, "fmi3GetString", FMI2_STRING, vr, nvr, values));
+    return leave(instance, fmi2_get_values(instance, "fmi3GetString", FMI2_TYPES(FMI2_STRING), vr, nvr, values));
 }
 
 fmi3Status fmi3SetString(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, const fmi3String values[],
                          size_t nValues) {
     INSTANCE(c, "fmi3SetString", SETTABLE);
     if (!counts_match(instance, "fmi3SetString", nvr, nValues)) return leave(instance, fmi2Error);
-    return leave(instance, fmi2_set_values(instance, "fmi3SetString", FMI2_STRING, vr, nvr, values));
+    return leave(instance, fmi2_set_values(instance, "fmi3SetString", FMI2_TYPES(FMI2_STRING), vr, nvr, values));
 }
 
-/* Boolean and Int32 values are held as fmi2Boolean and fmi2Integer: converted one by one on a get,
- * through a copy on a set (which changes none of the values if one is refused) */
-#define CONVERTED(Type, type, TYPE, held)                                                                          \
+/* Boolean values are held as fmi2Boolean, Int32 (Integer variables) and Int64 (Enumeration variables,
+ * as FMI 3.0 sets and gets them) as fmi2Integer: converted one by one on a get, through a copy on a
+ * set (which changes none of the values if one is refused; nor does one the held type cannot hold) */
+#define CONVERTED(Type, type, TYPES, held)                                                                         \
     fmi3Status fmi3Get##Type(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, type values[],             \
                              size_t nValues) {                                                                     \
         INSTANCE(c, "fmi3Get" #Type, GETTABLE);                                                                    \
         if (!counts_match(instance, "fmi3Get" #Type, nvr, nValues)) return leave(instance, fmi2Error);            \
         for (size_t i = 0; i < nvr; i++) {                                                                         \
             held value;                                                                                            \
-            if (fmi2_get_values(instance, "fmi3Get" #Type, TYPE, &vr[i], 1, &value) != fmi2OK)                     \
+            if (fmi2_get_values(instance, "fmi3Get" #Type, TYPES, &vr[i], 1, &value) != fmi2OK)                    \
                 return leave(instance, fmi2Error);                                                                 \
             values[i] = (type)value;                                                                               \
         }                                                                                                          \
@@ -209,13 +210,22 @@ fmi3Status fmi3SetString(fmi3Instance c, const fmi3ValueReference vr[], size_t n
             fmi2_log(instance, fmi2Error, "fmi3Set" #Type ": out of memory");                                      \
             return leave(instance, fmi2Error);                                                                     \
         }                                                                                                          \
-        for (size_t i = 0; i < nvr; i++) copy[i] = (held)values[i];                                                \
-        fmi2Status status = fmi2_set_values(instance, "fmi3Set" #Type, TYPE, vr, nvr, copy);                       \
+        fmi2Status status = fmi2OK;                                                                                \
+        for (size_t i = 0; i < nvr && status == fmi2OK; i++) {                                                     \
+            copy[i] = (held)values[i];                                                                             \
+            if ((type)copy[i] != values[i]) {                                                                      \
+                fmi2_log(instance, fmi2Error, "fmi3Set" #Type ": value %lu is beyond the range of every variable " \
+                         "of this type", (unsigned long)i);                                                        \
+                status = fmi2Error;                                                                                \
+            }                                                                                                      \
+        }                                                                                                          \
+        if (status == fmi2OK) status = fmi2_set_values(instance, "fmi3Set" #Type, TYPES, vr, nvr, copy);          \
         free(copy);                                                                                                \
         return leave(instance, status);                                                                            \
     }
-CONVERTED(Boolean, fmi3Boolean, FMI2_BOOLEAN, fmi2Boolean)
-CONVERTED(Int32, fmi3Int32, FMI2_INTEGER, fmi2Integer)
+CONVERTED(Boolean, fmi3Boolean, FMI2_TYPES(FMI2_BOOLEAN), fmi2Boolean)
+CONVERTED(Int32, fmi3Int32, FMI2_TYPES(FMI2_INTEGER), fmi2Integer)
+CONVERTED(Int64, fmi3Int64, FMI2_TYPES(FMI2_ENUMERATION), fmi2Integer)
 #undef CONVERTED
 
 /* the types of which the FMU has no variables: any value reference given is refused */
@@ -247,7 +257,6 @@ NO_SUCH_TYPE(UInt8, fmi3UInt8)
 NO_SUCH_TYPE(Int16, fmi3Int16)
 NO_SUCH_TYPE(UInt16, fmi3UInt16)
 NO_SUCH_TYPE(UInt32, fmi3UInt32)
-NO_SUCH_TYPE(Int64, fmi3Int64)
 NO_SUCH_TYPE(UInt64, fmi3UInt64)
 #undef NO_SUCH_TYPE
 

@@ -15,22 +15,13 @@
 
 typedef struct {
     AfOnline estimator;
-    int warned_step; /* a step size other than Ts was logged (once: a master with variable steps would log each) */
+    int noted_step; /* a step size other than Ts was logged (once: a master with variable steps would log each) */
 } Model;
 
 static const Fmi2Variable *variable_named(const char *name) {
     for (size_t vr = 0; vr < N_VARIABLES; vr++)
         if (strcmp(MODEL_VARIABLES[vr].name, name) == 0) return &MODEL_VARIABLES[vr];
     return NULL;
-}
-
-/* a String parameter that must be one of two words */
-static int either(Fmi2Instance *instance, const char *name, const char *value, const char *one, const char *other) {
-    if (strcmp(value, one) == 0 || strcmp(value, other) == 0) return 1;
-    char repr[FMI2_STRING_SIZE + 8];
-    fmi2_log(instance, fmi2Error, "invalid parameter: %s must be '%s' or '%s', got %s", name, one, other,
-             str_repr(value, repr, sizeof repr));
-    return 0;
 }
 
 static fmi2Status initialise(Fmi2Instance *instance) {
@@ -42,18 +33,21 @@ static fmi2Status initialise(Fmi2Instance *instance) {
                  float_repr(r[REAL_Ts], repr));
         return fmi2Error;
     }
-    if (!either(instance, "heading", instance->strings[STRING_heading], "mag", "gyro") ||
-        !either(instance, "gyro_offset", instance->strings[STRING_gyro_offset], "on", "off"))
-        return fmi2Error;
+    const char *method = fmi2_item(instance, INTEGER_method), *heading = fmi2_item(instance, INTEGER_heading),
+               *gyro_offset = fmi2_item(instance, INTEGER_gyro_offset),
+               *gyr_samples = fmi2_item(instance, INTEGER_gyr_samples),
+               *acc_samples = fmi2_item(instance, INTEGER_acc_samples);
+    if (!method || !heading || !gyro_offset || !gyr_samples || !acc_samples) return fmi2Error;
     AfConfig config = {
-        .method = instance->strings[STRING_method],
-        .heading = strcmp(instance->strings[STRING_heading], "mag") == 0,
-        .gyro_offset = strcmp(instance->strings[STRING_gyro_offset], "on") == 0,
+        .method = method,
+        .heading = strcmp(heading, "mag") == 0,
+        .gyro_offset = strcmp(gyro_offset, "on") == 0,
         .latency = r[REAL_latency],
-        .gyr_samples = instance->strings[STRING_gyr_samples],
-        .acc_samples = instance->strings[STRING_acc_samples],
+        .gyr_samples = gyr_samples,
+        .acc_samples = acc_samples,
     };
-    /* given: the tuning parameters whose values differ from their start values (NaN: unset) */
+    /* given: the tuning parameters whose values differ from their start values (a start or NaN: unset, the
+     * default of the stage that runs) */
     for (int k = 0; k < AF_N_PARAMS; k++) {
         const Fmi2Variable *v = variable_named(AF_PARAMS[k].name);
         if (!v || v->type != FMI2_REAL) {
@@ -68,7 +62,7 @@ static fmi2Status initialise(Fmi2Instance *instance) {
         fmi2_log(instance, fmi2Error, "invalid parameter: %s", message);
         return fmi2Error;
     }
-    model->warned_step = 0;
+    model->noted_step = 0;
     return fmi2OK;
 }
 
@@ -81,11 +75,10 @@ static fmi2Status step(Fmi2Instance *instance, fmi2Real t, fmi2Real h) {
     AfOnline *est = &model->estimator;
     fmi2Real *r = instance->reals;
     fmi2Status status = fmi2OK;
-    if (!model->warned_step && !same_step(h, r[REAL_Ts])) {
-        model->warned_step = 1;
-        fmi2_log(instance, fmi2Warning, "communication step %g s differs from Ts = %g s: filter re-discretised for it "
-                 "(and, without further warnings, for every other step size)", h, r[REAL_Ts]);
-        status = fmi2Warning;
+    if (!model->noted_step && !same_step(h, r[REAL_Ts])) {
+        model->noted_step = 1;
+        fmi2_log(instance, fmi2OK, "communication step %g s differs from Ts = %g s: filter re-discretised for it "
+                 "(and, without further notes, for every other step size)", h, r[REAL_Ts]);
     }
     /* each vector's components are consecutive in the table: x, y, z (w, x, y, z) */
     const double gyr[3] = {r[REAL_gyr_x], r[REAL_gyr_y], r[REAL_gyr_z]};

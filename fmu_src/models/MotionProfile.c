@@ -1,8 +1,10 @@
 /* MotionProfile.c: the model of the native MotionProfile.fmu: its variables (MotionProfile_variables.h,
  * generated from fmu_src/simulation_variables.py) onto the simulation's motions: the human motion's
- * stream (human_motion.h) and the closed forms (closed_form.h). doStep(t, h) outputs the
- * interval (t, t+h]. A profile's parameters are the Real parameters named <profile>_<parameter>, in
- * the order of systems/simulation/profile_table.py.
+ * stream on its grid (human_motion.h) and the closed forms (closed_form.h), both functions of time
+ * alone. doStep(t, h) outputs the interval (t, t+h]: the rate that turns the orientation over it, the
+ * specific force of its mean acceleration, field and orientation at t+h. A profile's parameters are the
+ * Real parameters named <profile>_<parameter>, in the order of systems/simulation/profile_table.py,
+ * checked against their plausible ranges at initialisation (profile_params.h).
  * The pythonfmu MotionProfile (fmu_src/MotionProfile.py) runs the same C core with the same checks,
  * messages and statuses. */
 #include <math.h>
@@ -14,6 +16,7 @@
 #include "earth_field.h"
 #include "human_motion.h"
 #include "noise.h"
+#include "profile_params.h"
 
 #define MESSAGE_SIZE 1024
 #define HUMAN "human" /* the human motion's profile name; the others are closed forms */
@@ -24,33 +27,30 @@ typedef struct {
     ClosedForm closed;
 } Model;
 
-/* the values of the profile's parameters, in the table's order: 0, or -1 with the refusal logged */
-static int profile_values(Fmi2Instance *instance, const char *profile, double values[CLOSED_FORM_MAX_PARAMS]) {
-    size_t prefix = strlen(profile), n = 0;
+/* the values of the profile's parameters, in the table's order, and their count: 0, or -1 with the
+ * refusal logged */
+static int profile_values(Fmi2Instance *instance, const char *profile, double values[SIM_PROFILE_MAX_PARAMS],
+                          size_t *n) {
+    size_t prefix = strlen(profile);
+    *n = 0;
     for (size_t vr = 0; vr < N_VARIABLES; vr++) {
         const Fmi2Variable *v = &MODEL_VARIABLES[vr];
         if (v->type != FMI2_REAL || v->causality != FMI2_PARAMETER || strncmp(v->name, profile, prefix) != 0 ||
             v->name[prefix] != '_')
             continue;
-        double value = instance->reals[v->index];
-        if (!isfinite(value)) {
-            char repr[FLOAT_REPR_SIZE];
-            fmi2_log(instance, fmi2Error, "invalid parameter: parameter %s must be finite, got %s",
-                     v->name + prefix + 1, float_repr(value, repr));
+        if (*n == SIM_PROFILE_MAX_PARAMS) {
+            fmi2_log(instance, fmi2Error, "profile %s has more parameters than sim_profiles.h holds", profile);
             return -1;
         }
-        if (n == CLOSED_FORM_MAX_PARAMS) {
-            fmi2_log(instance, fmi2Error, "profile %s has more parameters than closed_form.h holds", profile);
-            return -1;
-        }
-        values[n++] = value;
+        values[(*n)++] = instance->reals[v->index];
     }
     return 0;
 }
 
 static fmi2Status initialise(Fmi2Instance *instance) {
     Model *model = instance->state;
-    const char *name = instance->strings[STRING_profile];
+    const char *name = fmi2_item(instance, INTEGER_profile);
+    if (!name) return fmi2Error;
     char message[MESSAGE_SIZE], repr[FMI2_STRING_SIZE + 8];
     int profile = closed_form_profile(name), human = strcmp(name, HUMAN) == 0;
     if (profile < 0 && !human) {
@@ -63,36 +63,58 @@ static fmi2Status initialise(Fmi2Instance *instance) {
                  str_repr(name, repr, sizeof repr), available);
         return fmi2Error;
     }
-    double p[CLOSED_FORM_MAX_PARAMS] = {0.0};
-    if (profile_values(instance, name, p) != 0) return fmi2Error;
-    double g = instance->reals[REAL_g];
+    double p[SIM_PROFILE_MAX_PARAMS] = {0.0}, g = instance->reals[REAL_g];
+    size_t n;
+    const SimProfile *table = profile_named(name);
+    if (table == NULL) {
+        fmi2_log(instance, fmi2Error, "profile %s is not in sim_profiles.h", name);
+        return fmi2Error;
+    }
+    if (profile_values(instance, name, p, &n) != 0) return fmi2Error;
+    if (profile_check(table, p, n, g, message, sizeof message) != 0) {
+        fmi2_log(instance, fmi2Error, "invalid parameter: %s", message);
+        return fmi2Error;
+    }
     model->human = human;
     if (human) {
         HumanParams params = {p[0], p[1], p[2], p[3], g};
         uint64_t seed;
-        if (human_check(&params, message, sizeof message) != 0 ||
-            check_seed(instance->integers[INTEGER_seed], &seed, message, sizeof message) != 0) {
+        if (check_seed(instance->integers[INTEGER_seed], &seed, message, sizeof message) != 0) {
             fmi2_log(instance, fmi2Error, "invalid parameter: %s", message);
             return fmi2Error;
         }
-        human_stream_init(&model->stream, &params, seed);
+        human_stream_init(&model->stream, &params, p[4], seed);
     } else {
         model->closed.profile = (ClosedFormProfile)profile;
-        memcpy(model->closed.p, p, sizeof p);
+        memcpy(model->closed.p, p, sizeof model->closed.p);
         model->closed.g = g;
     }
     return fmi2OK;
 }
 
+/* the outputs of the interval (t, t + h]; where the step's arithmetic leaves them not finite, or the human
+ * motion refuses the step, fmi2Error with the reason and the outputs as they were */
 static fmi2Status step(Fmi2Instance *instance, fmi2Real t, fmi2Real h) {
     Model *model = instance->state;
     fmi2Real *r = instance->reals;
-    double out[HUMAN_N_OUT];
-    if (model->human) human_stream_step(&model->stream, h, out);
-    else closed_form_at(&model->closed, t + h, h, out, out + 3, out + 6);
+    double out[HUMAN_N_OUT + 3];
+    char message[MESSAGE_SIZE], a[FLOAT_REPR_SIZE], b[FLOAT_REPR_SIZE];
+    if (model->human) {
+        if (human_stream_step(&model->stream, t, t + h, out, message, sizeof message) != 0) {
+            fmi2_log(instance, fmi2Error, "%s", message);
+            return fmi2Error;
+        }
+    } else closed_form_at(&model->closed, t + h, h, out, out + 3, out + 6);
+    earth_field_in_sensor(out + 6, out + HUMAN_N_OUT);
+    for (int i = 0; i < HUMAN_N_OUT + 3; i++)
+        if (!isfinite(out[i])) {
+            fmi2_log(instance, fmi2Error, "a step of %s s to %s s overflows the motion's arithmetic",
+                     float_repr(h, a), float_repr(t + h, b));
+            return fmi2Error;
+        }
     for (int i = 0; i < 3; i++) r[REAL_omega_x + i] = out[i], r[REAL_f_x + i] = out[3 + i];
     for (int i = 0; i < 4; i++) r[REAL_qt_w + i] = out[6 + i];
-    earth_field_in_sensor(out + 6, &r[REAL_m_x]);
+    for (int i = 0; i < 3; i++) r[REAL_m_x + i] = out[HUMAN_N_OUT + i];
     return fmi2OK;
 }
 

@@ -1,7 +1,8 @@
 """Building the project's FMUs (FMI 2.0 co-simulation): those of fmu_src/ with pythonfmu
 into DIR/; the native ones, in C with no Python, which the package's build made
 (systems.fmi.native), copied into DIR/native/, the native estimator as FMI 3.0 co-simulation
-(systems.fmi.fmi3) into DIR/native/fmi3/.
+(systems.fmi.fmi3) into DIR/native/fmi3/; with platforms, the native FMUs with the binaries of other
+platforms too (systems.fmi.platforms).
 
 Each pythonfmu FMU carries in its resources the modules of attitude_fmu that its fmu_src
 adapter imports (carried_files), the compiled extension attitude_fmu._core among them, so it
@@ -30,8 +31,10 @@ import zipfile
 from pathlib import Path
 
 import attitude_fmu
+from attitude_fmu.build_fmu import project_version
+from attitude_fmu.fmu_src.documentation import write_documentation
 from attitude_fmu.fmu_src.fmu_support import PACKAGE, code_digest
-from attitude_fmu.systems.fmi import fmi3
+from attitude_fmu.systems.fmi import fmi3, platforms as cross
 from attitude_fmu.systems.fmi.native import NATIVE_NAMES, NotBuilt, built, copy_fmus, is_current
 
 FMU_NAMES = ("AttitudeEstimator", "ImuSensor", "MotionProfile")
@@ -123,13 +126,14 @@ def python_environment() -> str:
 
 def variable_types(model_description: bytes) -> str:
     """What fmi2_guard.c checks value references against: one line with the type of value
-    reference 0, 1, ... (R Real, I Integer, B Boolean, S String; - none)."""
+    reference 0, 1, ... (R Real, I Integer or Enumeration: both set and got as fmi2Integer, B Boolean,
+    S String; - none)."""
     from xml.etree import ElementTree
 
+    letters = {"Real": "R", "Integer": "I", "Enumeration": "I", "Boolean": "B", "String": "S"}
     types = {}
     for variable in ElementTree.fromstring(model_description).iter("ScalarVariable"):
-        kind = next(child.tag for child in variable if child.tag in ("Real", "Integer", "Boolean", "String"))
-        types[int(variable.get("valueReference"))] = kind[0]
+        types[int(variable.get("valueReference"))] = next(letters[c.tag] for c in variable if c.tag in letters)
     return "".join(types.get(vr, "-") for vr in range(max(types, default=-1) + 1)) + "\n"
 
 
@@ -142,10 +146,11 @@ def built_from(fmu) -> str | None:
         return None
 
 
-def build_fmus(out, names=FMU_NAMES, native=NATIVE_NAMES, fmi3_names=fmi3.FMI3_NAMES) -> list[Path]:
+def build_fmus(out, names=FMU_NAMES, native=NATIVE_NAMES, fmi3_names=fmi3.FMI3_NAMES, platforms=()) -> list[Path]:
     """Build the named pythonfmu FMUs into the directory out, and copy the named native ones
     into out/native and the named FMI 3.0 ones into out/native/fmi3 (none where the package's
-    build did not make them: a warning says so); returns their paths."""
+    build did not make them: a warning says so), with the binaries of the platforms (FMI 3.0
+    tuples, systems.fmi.platforms.add_platforms) added to those; returns their paths."""
     from pythonfmu.builder import FmuBuilder
 
     out = Path(out)
@@ -159,7 +164,9 @@ def build_fmus(out, names=FMU_NAMES, native=NATIVE_NAMES, fmi3_names=fmi3.FMI3_N
             for relative in (f for f in carried_files(name) if not f.endswith("__init__.py")):
                 (staged / relative).parent.mkdir(parents=True, exist_ok=True)
                 shutil.copy2(PACKAGE_DIR / relative, staged / relative)
+            documentation = write_documentation(Path(tmp) / name / "documentation", name, project_version())
             built_fmus.append(Path(FmuBuilder.build_FMU(SOURCE_DIR / f"{name}.py", dest=out, project_files=[staged],
+                                                        documentation_folder=documentation,
                                                         needsExecutionTool="false", canGetAndSetFMUstate="true",
                                                         canSerializeFMUstate="true")))
     for path in built_fmus:
@@ -169,7 +176,10 @@ def build_fmus(out, names=FMU_NAMES, native=NATIVE_NAMES, fmi3_names=fmi3.FMI3_N
             zf.writestr(FINGERPRINT, source_fingerprint(path.stem) + "\n")
             zf.writestr(PYTHON_ENVIRONMENT, python_environment())
             zf.writestr(VARIABLE_TYPES, variable_types(zf.read("modelDescription.xml")))
-    return built_fmus + copy_fmus(out / "native", native) + fmi3.copy_fmi3_fmus(out / "native" / "fmi3", fmi3_names)
+    copied = copy_fmus(out / "native", native) + fmi3.copy_fmi3_fmus(out / "native" / "fmi3", fmi3_names)
+    if platforms and copied:
+        cross.add_platforms(copied, platforms, log=lambda m: print(m, file=sys.stderr))
+    return built_fmus + copied
 
 
 GUARD_PLATFORMS = {"linux": "linux64", "darwin": "darwin64"}  # sys.platform prefix → FMI binaries folder
@@ -214,18 +224,20 @@ def install_guard(fmu: Path, guard: Path) -> None:
     staged.replace(fmu)
 
 
-def ensure_built(fmu_dir, rebuild: bool = False, log=print) -> Path:
+def ensure_built(fmu_dir, rebuild: bool = False, log=print, platforms=()) -> Path:
     """The directory holding every FMU, building those missing or built from other sources
     than this installation's (or all with rebuild): FMUs loaded into one process share the
     first-loaded copy of the project's modules, so the ones run must match the code; a
-    native FMU is current where its guid is that of the package's (systems.fmi.native.is_current)."""
+    native FMU is current where its guid is that of the package's (systems.fmi.native.is_current)
+    and it holds the binaries of the platforms (FMI 3.0 tuples: systems.fmi.platforms)."""
     fmu_dir = Path(fmu_dir)
     names = {n: fmu_dir / f"{n}.fmu" for n in FMU_NAMES}
     names.update({f"native/{n}": fmu_dir / "native" / f"{n}.fmu" for n in NATIVE_NAMES})
     names.update({f"native/fmi3/{n}": fmu_dir / "native" / "fmi3" / f"{n}.fmu" for n in fmi3.FMI3_NAMES})
     missing = [n for n, path in names.items() if rebuild or not path.is_file()]
     stale = [n for n, path in names.items() if n not in missing and not (
-        fmi3.is_current(path) if n.startswith("native/fmi3/") else is_current(path) if n.startswith("native/")
+        fmi3.is_current(path) and cross.holds_platforms(path, platforms) if n.startswith("native/fmi3/")
+        else is_current(path) and cross.holds_platforms(path, platforms) if n.startswith("native/")
         else built_from(path) == source_fingerprint(n))]
     if missing:
         log(f"building {', '.join(missing)} into {fmu_dir}")
@@ -234,5 +246,5 @@ def ensure_built(fmu_dir, rebuild: bool = False, log=print) -> Path:
     todo = set(missing) | set(stale)
     if todo:
         build_fmus(fmu_dir, [n for n in FMU_NAMES if n in todo], [n for n in NATIVE_NAMES if f"native/{n}" in todo],
-                   [n for n in fmi3.FMI3_NAMES if f"native/fmi3/{n}" in todo])
+                   [n for n in fmi3.FMI3_NAMES if f"native/fmi3/{n}" in todo], platforms)
     return fmu_dir

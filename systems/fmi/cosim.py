@@ -1,11 +1,11 @@
 """A small co-simulation master for the project's SSP files, on fmpy's FMU2Slave API.
 
-fmpy.ssp.simulate_ssp falls short here in three ways: it ignores the parameter bindings
-inside the SSD (it takes one parameter set as an argument), it cannot set String
-variables (the estimator's `method`, the motion's `profile`), and it passes values along
+fmpy.ssp.simulate_ssp falls short here in two ways: it ignores the parameter bindings
+inside the SSD (it takes one parameter set as an argument), and it passes values along
 connections only after every component has stepped, so each connection delays by one
 step and every connector starts at 0. This master reads the same SSD with fmpy, applies
-its inline parameter values of every type, and steps the components in the order of
+its inline parameter values of every type (an Enumeration's by item name or value:
+enumeration_value), and steps the components in the order of
 their connections (Gauss–Seidel): in doStep(t, h) the estimator receives the sensor
 samples of (t, t+h], exactly as the batch path consumes them. The steps run in C
 (systems.fmi.stepping) where a C compiler is at hand, else in Python. cosimulate_libcosim runs
@@ -36,6 +36,44 @@ def load_slave(md, unzipdir, instance_name: str) -> FMU2Slave:
                      instanceName=instance_name)
 
 
+def enumeration_value(variable, value) -> int:
+    """The integer value of an item of an Enumeration variable of fmpy's model description
+    (the estimator's `method`, the motion's `profile`, ...), given by its name as the command
+    line spells it, or by its value; ValueError naming the items if it has no such item."""
+    items = {item.name: int(item.value) for item in variable.declaredType.items}
+    if isinstance(value, str) and value in items:
+        return items[value]
+    if not isinstance(value, (str, bool)) and value in items.values():
+        return int(value)
+    raise ValueError(f"{variable.name} must be one of {', '.join(items)}; got {value!r}")
+
+
+def start_values(model_description, values: dict) -> dict:
+    """values (variable name → value) as an FMU takes them: each Enumeration's item name as its
+    integer value (enumeration_value), the others as given; for fmpy.simulate_fmu's start_values."""
+    variables = {v.name: v for v in model_description.modelVariables}
+    return {name: enumeration_value(variables[name], value)
+            if name in variables and variables[name].type == "Enumeration" else value
+            for name, value in values.items()}
+
+
+def set_value(fmu: FMU2Slave, variable, value) -> None:
+    """Set a variable of fmpy's model description on an FMI 2.0 instance, by its type: a Real
+    (float), an Integer (int), an Enumeration (its item name or value: enumeration_value), a
+    Boolean (bool, or the text true/false) or a String."""
+    vr = [variable.valueReference]
+    if variable.type == "Enumeration":
+        fmu.setInteger(vr, [enumeration_value(variable, value)])
+    elif variable.type == "Integer":
+        fmu.setInteger(vr, [int(value)])
+    elif variable.type == "Boolean":
+        fmu.setBoolean(vr, [value.lower() == "true" if isinstance(value, str) else bool(value)])
+    elif variable.type == "String":
+        fmu.setString(vr, [str(value)])
+    else:
+        fmu.setReal(vr, [float(value)])
+
+
 def fmus_loaded() -> bool:
     """Whether this process loaded an FMU. pythonfmu's export library finalises its Python
     state from a library destructor, which can crash at interpreter shutdown after all
@@ -64,16 +102,9 @@ class _Component:
         self.fmu.instantiate()
         self.fmu.setupExperiment(startTime=start_time)
         self.fmu.enterInitializationMode()
-        for p in parameters:
-            vr = [self.variables[p.name].valueReference]
-            if p.type == "Real":
-                self.fmu.setReal(vr, [float(p.value)])
-            elif p.type == "Integer":
-                self.fmu.setInteger(vr, [int(p.value)])
-            elif p.type == "Boolean":
-                self.fmu.setBoolean(vr, [p.value.lower() == "true"])
-            else:
-                self.fmu.setString(vr, [p.value])
+        for p in parameters:  # an SSD's values are text (an Enumeration's: its item's value or name)
+            variable = self.variables[p.name]
+            set_value(self.fmu, variable, int(p.value) if p.type == "Integer" else p.value)
         self.fmu.exitInitializationMode()
         self.input_vr = [self.variables[name].valueReference for name, _, _ in self.inputs]
 
@@ -255,16 +286,7 @@ class FmuRunner:
         self.fmu.setupExperiment(startTime=0.0)
         self.fmu.enterInitializationMode()
         for name, value in self.parameters.items():
-            vr = [self.variables[name].valueReference]
-            kind = self.variables[name].type
-            if kind == "String":
-                self.fmu.setString(vr, [value])
-            elif kind == "Integer":
-                self.fmu.setInteger(vr, [int(value)])
-            elif kind == "Boolean":
-                self.fmu.setBoolean(vr, [bool(value)])
-            else:
-                self.fmu.setReal(vr, [float(value)])
+            set_value(self.fmu, self.variables[name], value)
         self.fmu.exitInitializationMode()
         self.time = 0.0
 

@@ -23,6 +23,7 @@ agrees at every step), held within CHAIN_TOLERANCE. Each configuration runs the 
 from __future__ import annotations
 
 import math
+import sys
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -36,7 +37,9 @@ from attitude_fmu.blocks.methods.registry import METHODS
 from attitude_fmu.blocks.methods.registry import method as get_method
 from attitude_fmu.blocks.methods.wiener_local import settled_filter
 from attitude_fmu.systems.cluster.jobs import Failure, Jobs
+from attitude_fmu.systems.fmi.build import ensure_built
 from attitude_fmu.systems.fmi.cosim import cosimulate
+from attitude_fmu.systems.fmi.platforms import parse_platforms
 from attitude_fmu.systems.fmi.ssp import CHAINS, COMPONENTS, write_ssp
 from attitude_fmu.systems.simulation.motion import PROFILES
 
@@ -204,12 +207,17 @@ def verify_job(fmu_dir, profile: str, method: str, step: float = STEP_S, chain: 
 
 
 def verify(fmu_dir, profiles=None, methods=None, step: float = STEP_S, progress: bool = True,
-           python: bool = False, jobs: Jobs | None = None) -> list[dict]:
+           python: bool = False, jobs: Jobs | None = None, platforms: str = "host") -> list[dict]:
     """Rows for every profile × method (default: all), on the native chain where it is built
     (chain_of), with python the pythonfmu chain beside it (verify_one). Each row is a job of
     jobs (systems.cluster.jobs.Jobs; default: this process, a bar when progress), whose
     workers see fmu_dir at its absolute path; a row whose job failed (jobs reports it) is left
-    out."""
+    out. platforms (systems.fmi.platforms.parse_platforms: host, all or a list of FMI 3.0 tuples):
+    the native FMUs are first made to hold those platforms' binaries (ensure_built), and the
+    chain runs this machine's among them (x86_64-linux: the glibc 2.17 one)."""
+    wanted = parse_platforms(platforms)
+    if wanted:
+        ensure_built(fmu_dir, log=lambda m: print(f"attitude: {m}", file=sys.stderr), platforms=wanted)
     chain = chain_of(fmu_dir)
     runs = [(p, m) for p in list(profiles or SCENARIOS) for m in list(methods or METHODS)]
     jobs = jobs or Jobs(bar=progress)

@@ -7,7 +7,6 @@ in sensor coordinates, with a the mean acceleration over the sample interval.
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -19,6 +18,8 @@ from attitude_fmu.blocks.tuning import STANDARD_GRAVITY
 from attitude_fmu.systems.simulation import profile_table
 from attitude_fmu.systems.simulation.noise import MOTION, normals
 from attitude_fmu.systems.simulation.profile_table import EARTH_FIELD_UT  # noqa: F401 (the earth's field, µT)
+
+HUMAN_GRID = next(p.default for p in profile_table.PROFILES["human"][1] if p.name == "grid")  # s
 
 AXES = ("x", "y", "z")
 TRUTH_OUTPUTS = [f"omega_{a}" for a in AXES] + [f"f_{a}" for a in AXES] + [
@@ -61,14 +62,18 @@ def earth_field(quat) -> np.ndarray:
 
 @dataclass(frozen=True)
 class HumanMotion:
-    """Band-limited human motion (Rizun eq. 14) with a band-limited random rotation.
+    """Band-limited human motion (Rizun eq. 14) with a band-limited random rotation, on a time grid.
 
     delta_v: slosh, density of the earth-frame velocity, m/s/√Hz (one-sided);
     omega_c: band limit of the velocity, rad/s; rot_rms: RMS angular rate per axis,
-    rad/s; rot_cutoff: band limit of the angular rate, rad/s; g: gravity, m/s².
-    Velocity and angular rate are first-order low-passed white noise (exact
-    Ornstein–Uhlenbeck steps, systems/simulation/core/human_motion.c), so velocity has the
-    spectrum of eq. 14.
+    rad/s; rot_cutoff: band limit of the angular rate, rad/s; g: gravity, m/s²;
+    grid: the time grid, s (None: the sample interval of generate()). Velocity and angular
+    rate are first-order low-passed white noise, exact Ornstein–Uhlenbeck steps from one grid
+    point to the next with a draw of the noise stream MOTION per cell (so velocity has the
+    spectrum of eq. 14 at the grid points); within a cell the rate and the acceleration are
+    constant, so orientation and velocity are exact at every time and a sample over any
+    interval depends on that interval alone (systems/simulation/core/human_motion.c).
+    Parameters outside their plausible ranges (profile_table.py) are refused with ValueError.
     """
 
     delta_v: float = 1.0
@@ -76,30 +81,39 @@ class HumanMotion:
     rot_rms: float = 1.0
     rot_cutoff: float = 5.0
     g: float = STANDARD_GRAVITY
+    grid: float | None = None
 
     def __post_init__(self):
-        _core.human_check(*self._params())
+        grid = HUMAN_GRID if self.grid is None else self.grid
+        _core.profile_check("human", np.array([*self._params()[:4], grid], dtype=float), self.g)
 
     def _params(self) -> tuple:
         return self.delta_v, self.omega_c, self.rot_rms, self.rot_cutoff, self.g
 
     def coefficients(self, fs: float) -> np.ndarray:
-        """[phi_v, sig_v, phi_w, sig_w, Ts, g] of the exact OU steps at sample rate fs."""
+        """[phi_v, sig_v, phi_w, sig_w, Ts, g] of the exact OU steps of a grid cell of 1/fs s."""
         return _core.human_coefficients(*self._params(), fs)
 
     def generate(self, duration: float, fs: float, seed: int = 0) -> Motion:
         """Sample duration (s) at fs (Hz) from a fixed seed (the noise stream MOTION of
-        systems.simulation.noise); starts level, at rest."""
+        systems.simulation.noise); starts level, at rest. With grid None the grid is the sample
+        interval (a cell per sample); else the motion on its grid, sampled over (t[k−1], t[k]]."""
         n = int(round(duration * fs))
         if n < 1:
             raise ValueError(f"duration·fs must give at least one sample, got {duration!r}·{fs!r}")
         out = np.empty((n, _core.HUMAN_N_OUT))
-        _core.human_run(self.initial_state(), normals(seed, MOTION, n), self.coefficients(fs), out)
+        if self.grid is None:
+            _core.human_run(self.initial_state(), normals(seed, MOTION, n), self.coefficients(fs), out)
+        else:
+            self.stream(seed).run(np.arange(1, n + 1) / fs, out)
         return Motion(fs, out[:, 6:10], out[:, 0:3], out[:, 3:6])
 
     def system(self, fs: float, name: str = "motion"):
         """Discrete python-control system: inputs eps_v_x..z, eps_w_x..z (unit normal
-        noise per sample); states v (m/s), omega (rad/s), q; outputs TRUTH_OUTPUTS."""
+        noise per sample); states v (m/s), omega (rad/s), q; outputs TRUTH_OUTPUTS. A cell
+        per sample: grid None (or 1/fs)."""
+        if self.grid is not None and self.grid != 1.0 / fs:
+            raise ValueError(f"the system takes a grid cell per sample: grid {self.grid!r} s at fs {fs!r} Hz")
         coef = self.coefficients(fs)
 
         def advance(state, u):
@@ -117,9 +131,10 @@ class HumanMotion:
         return np.array([0, 0, 0, 0, 0, 0, 1.0, 0, 0, 0])
 
     def stream(self, seed: int = 0) -> _core.HumanStream:
-        """Sample by sample (for the motion FMU): step(t, h) gives (gyr, specific force, quat)
-        for the interval (t − h, t], equal to generate() with the same seed."""
-        return _core.HumanStream(*self._params(), seed)
+        """The motion on its grid (None: profile_table.py's default) over any intervals from time 0
+        (for the motion FMU): step(t, h) gives (gyr, specific force, quat) for the interval (t − h, t]
+        as generate() samples it."""
+        return _core.HumanStream(*self._params()[:4], HUMAN_GRID if self.grid is None else self.grid, self.g, seed)
 
 
 @dataclass(frozen=True)
@@ -134,6 +149,9 @@ class ClosedForm:
     name: str
     params: tuple
     g: float = STANDARD_GRAVITY
+
+    def __post_init__(self):
+        _core.profile_check(self.name, np.array(self.params, dtype=float), self.g)
 
     def at(self, t, h: float):
         """(gyr N×3, specific force N×3, quat N×4) for the intervals ending at times t."""
@@ -153,7 +171,11 @@ class ClosedForm:
         return self
 
     def step(self, t: float, h: float):
+        """(gyr, specific force, quat) of the interval (t − h, t]; ValueError where the step's
+        arithmetic overflows (outputs not finite), as MotionProfile.fmu refuses it."""
         gyr, acc, quat = self.at(t, h)
+        if not (np.isfinite(gyr).all() and np.isfinite(acc).all() and np.isfinite(quat).all()):
+            raise ValueError(f"a step of {h!r} s to {t!r} s overflows the motion's arithmetic")
         return gyr[0], acc[0], quat[0]
 
 
@@ -167,13 +189,12 @@ class Profile:
     params: tuple
 
     def motion(self, overrides: dict | None = None, g: float = STANDARD_GRAVITY):
-        """The motion for these parameter overrides (unknown names are refused)."""
+        """The motion for these parameter overrides (unknown names and values outside the plausible
+        ranges of profile_table.py are refused with ValueError)."""
         known = {p.name: p.default for p in self.params}
         for name, value in (overrides or {}).items():
             if name not in known:
                 raise ValueError(f"unknown parameter {name!r} for profile {self.name!r}; known: {', '.join(known)}")
-            if not math.isfinite(value):
-                raise ValueError(f"parameter {name} must be finite, got {value!r}")
             known[name] = float(value)
         if self.name == "human":
             return HumanMotion(**known, g=g)

@@ -6,52 +6,60 @@ from __future__ import annotations
 
 import math
 
-from attitude_fmu.blocks.params import Param
+from attitude_fmu.blocks.params import GRAVITY_M_S2, Param
+from attitude_fmu.blocks.tuning import STANDARD_GRAVITY
 
 EARTH_FIELD_UT = (0.0, 20.0, -45.0)  # magnetic field in ENU, µT: northwards and down
+RATE_MAX = math.radians(4000.0)  # rad/s: the widest gyro range
+GRAVITY = Param("g", STANDARD_GRAVITY, "m/s^2", "magnitude of gravity, every profile's", **GRAVITY_M_S2)
 
-# profile name → (summary, parameters in the order the profile's function takes them)
+# profile name → (summary, parameters in the order the profile's function takes them); each parameter's
+# plausible range low ≤ value ≤ high (signed where a negative value has a meaning), and gravity's, is checked
+# by the simulation's C core (systems/simulation/core/profile_params.c), in the table the build generates
+# from this one (sim_profiles.h, by blocks/core/generate_tables.py)
 PROFILES = {
     "human": ("band-limited human motion (Rizun eq. 14) with random rotation", (
-        Param("delta_v", 1.0, "m/s/√Hz", "slosh: density of the velocity"),
-        Param("omega_c", 10.0, "rad/s", "band limit of the velocity"),
-        Param("rot_rms", 1.0, "rad/s", "RMS angular rate per axis"),
-        Param("rot_cutoff", 5.0, "rad/s", "band limit of the angular rate"),
+        Param("delta_v", 1.0, "m/s/√Hz", "slosh: density of the velocity", True, 0.0, 100.0),
+        Param("omega_c", 10.0, "rad/s", "band limit of the velocity", low=1e-4, high=1e5),
+        Param("rot_rms", 1.0, "rad/s", "RMS angular rate per axis", True, 0.0, RATE_MAX),
+        Param("rot_cutoff", 5.0, "rad/s", "band limit of the angular rate", low=1e-4, high=1e5),
+        Param("grid", 1e-3, "s", "time grid of the motion: a noise draw per cell, rate and acceleration constant "
+              "within one (the outputs at a time do not depend on the steps taken)", low=1e-6, high=1.0),
     )),
     "lever_arm": ("steady rotation about the vertical on a lever arm (Rizun §2.4)", (
-        Param("rate", 2.0, "rad/s", "turn rate"),
-        Param("radius", 0.2, "m", "arm length"),
+        Param("rate", 2.0, "rad/s", "turn rate", True, -RATE_MAX, RATE_MAX),
+        Param("radius", 0.2, "m", "arm length", True, 0.0, 100.0),
     )),
     "incline": ("harmonic motion along a 45° incline, peak √2·g (Rizun §2.5)", (
-        Param("incline_deg", 45.0, "deg", "slope of the incline"),
-        Param("peak_acc_g", math.sqrt(2.0), "1", "peak acceleration in units of g"),
-        Param("frequency", 1.0, "Hz", "frequency of the oscillation"),
+        Param("incline_deg", 45.0, "deg", "slope of the incline", True, -90.0, 90.0),
+        Param("peak_acc_g", math.sqrt(2.0), "1", "peak acceleration in units of g", True, 0.0, 100.0),
+        Param("frequency", 1.0, "Hz", "frequency of the oscillation", low=1e-4, high=1e3),
     )),
     "coning": ("Luinge's coning motion, theta = rate = 1", (
-        Param("theta", 1.0, "rad", "half-angle of the cone"),
-        Param("rate", 1.0, "rad/s", "coning rate"),
+        Param("theta", 1.0, "rad", "half-angle of the cone", True, -math.pi, math.pi),
+        Param("rate", 1.0, "rad/s", "coning rate", True, -RATE_MAX, RATE_MAX),
     )),
     "sine_rotation": ("Tseng 1-2: ±10° sinusoidal pitch, optionally inclined", (
-        Param("amplitude_deg", 10.0, "deg", "pitch amplitude"),
-        Param("frequency", 0.5, "Hz", "pitch frequency"),
-        Param("inclination_deg", 0.0, "deg", "IMU inclination about x (Tseng 2: 20)", True),
+        Param("amplitude_deg", 10.0, "deg", "pitch amplitude", True, -360.0, 360.0),
+        Param("frequency", 0.5, "Hz", "pitch frequency", True, 0.0, 1e3),
+        Param("inclination_deg", 0.0, "deg", "IMU inclination about x (Tseng 2: 20)", True, -180.0, 180.0),
     )),
     "step_rotation": ("Tseng 3: pitch steps of 5, 10, 20, 45, 90°", (
-        Param("hold", 10.0, "s", "time each level is held"),
-        Param("ramp", 0.2, "s", "duration of each raised-cosine step"),
+        Param("hold", 10.0, "s", "time each level is held", low=1e-3, high=1e6),
+        Param("ramp", 0.2, "s", "duration of each raised-cosine step", True, 0.0, 1e6),
     )),
     "linear_motion": ("Tseng 4: back and forth along a line, IMU mounted at an angle", (
-        Param("amplitude", 0.5, "m", "travel"),
-        Param("period", 4.0, "s", "period of the back-and-forth"),
-        Param("mount_x_deg", 0.0, "deg", "mounting rotation about X", True),
-        Param("mount_y_deg", 0.0, "deg", "mounting rotation about Y", True),
-        Param("mount_z_deg", 0.0, "deg", "mounting rotation about Z", True),
+        Param("amplitude", 0.5, "m", "travel", True, 0.0, 1e3),
+        Param("period", 4.0, "s", "period of the back-and-forth", low=1e-3, high=1e6),
+        Param("mount_x_deg", 0.0, "deg", "mounting rotation about X", True, -360.0, 360.0),
+        Param("mount_y_deg", 0.0, "deg", "mounting rotation about Y", True, -360.0, 360.0),
+        Param("mount_z_deg", 0.0, "deg", "mounting rotation about Z", True, -360.0, 360.0),
     )),
     "offset_rotation": ("Tseng 5: 0.4 Hz yaw oscillation on a 20 cm arm", (
-        Param("frequency", 0.4, "Hz", "yaw frequency"),
-        Param("amplitude_deg", 45.0, "deg", "yaw amplitude"),
-        Param("radius", 0.2, "m", "arm length"),
-        Param("inclination_deg", 0.0, "deg", "IMU inclination about x", True),
-        Param("pitch_deg", 0.0, "deg", "IMU pitch about y", True),
+        Param("frequency", 0.4, "Hz", "yaw frequency", True, 0.0, 1e3),
+        Param("amplitude_deg", 45.0, "deg", "yaw amplitude", True, -360.0, 360.0),
+        Param("radius", 0.2, "m", "arm length", True, 0.0, 100.0),
+        Param("inclination_deg", 0.0, "deg", "IMU inclination about x", True, -180.0, 180.0),
+        Param("pitch_deg", 0.0, "deg", "IMU pitch about y", True, -180.0, 180.0),
     )),
 }

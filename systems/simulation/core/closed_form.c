@@ -91,13 +91,13 @@ static Vec3 velocity(const ClosedForm *m, double t) {
     }
 }
 
-/* Rotation.as_rotvec: the rotation vector (rad) of q, taken with w >= 0 */
-static Vec3 rotvec(Quat q) {
+void rotation_vector(const double quat[4], double r[3]) {
+    Quat q = quat_load(quat);
     if (q.w < 0.0) q = (Quat){-q.w, -q.x, -q.y, -q.z};
     double angle = 2.0 * atan2(sqrt(q.x * q.x + q.y * q.y + q.z * q.z), q.w);
     double angle2 = angle * angle;
     double scale = angle <= 1e-3 ? 2.0 + angle2 / 12.0 + 7.0 * angle2 * angle2 / 2880.0 : angle / sin(angle / 2.0);
-    return (Vec3){scale * q.x, scale * q.y, scale * q.z};
+    r[0] = scale * q.x, r[1] = scale * q.y, r[2] = scale * q.z;
 }
 
 int closed_form_profile(const char *name) {
@@ -108,8 +108,10 @@ int closed_form_profile(const char *name) {
 
 void closed_form_at(const ClosedForm *m, double t, double h, double gyr[3], double f[3], double quat[4]) {
     Quat now = orientation(m, t), before = orientation(m, t - h);
-    Vec3 r = rotvec(quat_multiply(quat_conjugate(before), now));
-    gyr[0] = r.x / h, gyr[1] = r.y / h, gyr[2] = r.z / h;
+    double turn[4];
+    quat_store(quat_multiply(quat_conjugate(before), now), turn);
+    rotation_vector(turn, gyr);
+    for (int i = 0; i < 3; i++) gyr[i] /= h;
     Vec3 v = velocity(m, t), v0 = velocity(m, t - h);
     Vec3 acc = {(v.x - v0.x) / h, (v.y - v0.y) / h, (v.z - v0.z) / h + m->g};
     Vec3 sensor = quat_rotate(quat_conjugate(now), acc);

@@ -8,7 +8,9 @@
 
 #include <stddef.h>
 
-#define CLOSED_FORM_MAX_PARAMS 5
+#include "sim_profiles.h" /* SIM_PROFILE_MAX_PARAMS (generated from profile_table.py) */
+
+#define CLOSED_FORM_MAX_PARAMS SIM_PROFILE_MAX_PARAMS
 
 typedef enum {
     /* Rizun 2.4: turning at rate (rad/s) about the vertical on an arm of radius (m), the sensor
@@ -47,6 +49,8 @@ typedef struct {
     double g;
 } ClosedForm;
 
+/* Rotation.as_rotvec: the rotation vector r (rad) of the unit quaternion quat, taken with w >= 0 */
+void rotation_vector(const double quat[4], double r[3]);
 /* the profile of that name: its number, or -1 */
 int closed_form_profile(const char *name);
 /* the interval (t - h, t]: gyr (rad/s), specific force f (m/s^2, sensor coordinates), quat (at t) */

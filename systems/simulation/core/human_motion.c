@@ -1,24 +1,12 @@
-/* human_motion.c: HumanMotion's exact steps. */
+/* human_motion.c: HumanMotion's exact steps, a grid cell each, and its stream over any intervals of the grid. */
 #include "human_motion.h"
 
 #include <math.h>
 
+#include "closed_form.h"
 #include "messages.h"
 #include "quaternion.h"
 #include "noise.h"
-
-int human_check(const HumanParams *p, char *message, size_t size) {
-    const char *names[4] = {"delta_v", "omega_c", "rot_cutoff", "g"};
-    const double values[4] = {p->delta_v, p->omega_c, p->rot_cutoff, p->g};
-    char repr[FLOAT_REPR_SIZE];
-    for (int i = 0; i < 4; i++)
-        if (!(isfinite(values[i]) && values[i] > 0.0))
-            return refuse(message, size, "%s must be a finite positive number, got %s", names[i],
-                          float_repr(values[i], repr));
-    if (!(isfinite(p->rot_rms) && p->rot_rms >= 0.0))
-        return refuse(message, size, "rot_rms must be finite and non-negative, got %s", float_repr(p->rot_rms, repr));
-    return 0;
-}
 
 void human_coefficients(const HumanParams *p, double fs, double coef[HUMAN_N_COEF]) {
     double Ts = 1.0 / fs;
@@ -61,20 +49,72 @@ void human_run(double state[HUMAN_N_STATES], const double *noise, size_t n, cons
     for (size_t k = 0; k < n; k++) human_step(state, noise + 6 * k, coef, out + HUMAN_N_OUT * k);
 }
 
-void human_stream_init(HumanStream *stream, const HumanParams *params, uint64_t seed) {
+void human_stream_init(HumanStream *stream, const HumanParams *params, double grid, uint64_t seed) {
     stream->params = *params;
     stream->seed = seed;
     stream->k = 0;
-    stream->h = 0.0;
+    stream->grid = grid;
+    human_coefficients(params, 1.0 / grid, stream->coef);
+    stream->coef[4] = grid;
     human_initial_state(stream->state);
+    for (int i = 0; i < 3; i++) stream->v0[i] = 0.0, stream->acc[i] = 0.0;
+    for (int i = 0; i < 4; i++) stream->q0[i] = stream->state[6 + i];
+    stream->t = 0.0;
 }
 
-void human_stream_step(HumanStream *stream, double h, double out[HUMAN_N_OUT]) {
-    if (h != stream->h) {
-        human_coefficients(&stream->params, 1.0 / h, stream->coef);
-        stream->h = h;
+/* the next grid cell: its noise, its state at its start and end, its acceleration */
+static void draw_cell(HumanStream *s) {
+    double noise[MOTION_WIDTH], out[HUMAN_N_OUT];
+    noise_normals(s->seed, MOTION, s->k++, MOTION_WIDTH, noise);
+    for (int i = 0; i < 3; i++) s->v0[i] = s->state[i];
+    for (int i = 0; i < 4; i++) s->q0[i] = s->state[6 + i];
+    human_step(s->state, noise, s->coef, out);
+    for (int i = 0; i < 3; i++) s->acc[i] = (s->state[i] - s->v0[i]) / s->grid;
+}
+
+int human_stream_step(HumanStream *s, double start, double end, double out[HUMAN_N_OUT], char *message,
+                      size_t size) {
+    char a[FLOAT_REPR_SIZE], b[FLOAT_REPR_SIZE], c[FLOAT_REPR_SIZE];
+    double G = s->grid;
+    if (!(isfinite(start) && isfinite(end) && start <= end && start >= s->t - 1e-9 * fmax(1.0, s->t)))
+        return refuse(message, size, "the human motion steps forward from time 0 s: not over (%s, %s] s after %s s",
+                      float_repr(start, a), float_repr(end, b), float_repr(s->t, c));
+    if (ceil(end / G) - (double)s->k > HUMAN_MAX_CELLS)
+        return refuse(message, size, "a step to %s s needs more than %.0f cells of the human motion's grid (%s s)",
+                      float_repr(end, a), HUMAN_MAX_CELLS, float_repr(G, b));
+    start = fmax(start, s->t);
+    Quat turn = {1.0, 0.0, 0.0, 0.0};
+    double dv[3] = {0.0, 0.0, 0.0}, t = start;
+    for (;;) { /* the pieces of the cells (start, end] crosses */
+        double cell_end = (double)s->k * G;
+        if (s->k > 0 && t < cell_end) {
+            double piece_end = fmin(end, cell_end), tau = piece_end - t;
+            turn = quat_multiply(turn, rotvec_quat(s->state[3] * tau, s->state[4] * tau, s->state[5] * tau));
+            for (int i = 0; i < 3; i++) dv[i] += s->acc[i] * tau;
+            t = piece_end;
+        }
+        if (end <= cell_end) break;
+        draw_cell(s);
     }
-    double noise[MOTION_WIDTH];
-    noise_normals(stream->seed, MOTION, stream->k++, MOTION_WIDTH, noise);
-    human_step(stream->state, noise, stream->coef, out);
+    double h = end - start;
+    if (!(h > 0.0) && (s->k == 0 || start >= (double)s->k * G)) draw_cell(s); /* the cell that starts at start */
+    Quat q = quat_load(s->q0);
+    if (end >= (double)s->k * G) q = quat_load(s->state + 6);
+    else {
+        double tau = end - (double)(s->k - 1) * G;
+        q = quat_normalized(quat_multiply(q, rotvec_quat(s->state[3] * tau, s->state[4] * tau, s->state[5] * tau)));
+    }
+    double w[3] = {s->state[3], s->state[4], s->state[5]}, acc[3] = {s->acc[0], s->acc[1], s->acc[2]};
+    if (h > 0.0) {
+        double r[4];
+        quat_store(quat_normalized(turn), r);
+        rotation_vector(r, w);
+        for (int i = 0; i < 3; i++) w[i] /= h, acc[i] = dv[i] / h;
+    }
+    Vec3 f = quat_rotate(quat_conjugate(q), (Vec3){acc[0], acc[1], acc[2] + s->params.g});
+    out[0] = w[0], out[1] = w[1], out[2] = w[2];
+    out[3] = f.x, out[4] = f.y, out[5] = f.z;
+    quat_store(q, out + 6);
+    s->t = end;
+    return 0;
 }

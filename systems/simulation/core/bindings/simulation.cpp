@@ -17,6 +17,7 @@ extern "C" {
 #include "earth_field.h"
 #include "human_motion.h"
 #include "noise.h"
+#include "profile_params.h"
 #include "sensor.h"
 }
 
@@ -70,12 +71,35 @@ uint64_t seed_value(nb::handle seed)
     throw nb::value_error(message);
 }
 
-HumanParams human_params(double delta_v, double omega_c, double rot_rms, double rot_cutoff, double g)
+// the profile's parameters (n, profile_table.py's order) and g checked (profile_params.h): ValueError with the
+// refusal, or for a name that is no profile
+void check_profile(const std::string &name, const double *values, size_t n, double g)
 {
-    HumanParams p = {delta_v, omega_c, rot_rms, rot_cutoff, g};
+    const SimProfile *profile = profile_named(name.c_str());
+    if (profile == nullptr) throw nb::value_error(("no motion profile " + name).c_str());
     char message[MESSAGE_SIZE];
-    raise_if(human_check(&p, message, sizeof message), message);
-    return p;
+    raise_if(profile_check(profile, values, n, g, message, sizeof message), message);
+}
+
+// the human motion's parameters and its grid (s), checked
+HumanParams human_params(double delta_v, double omega_c, double rot_rms, double rot_cutoff, double grid, double g)
+{
+    const double values[5] = {delta_v, omega_c, rot_rms, rot_cutoff, grid};
+    check_profile("human", values, 5, g);
+    return HumanParams{delta_v, omega_c, rot_rms, rot_cutoff, g};
+}
+
+// the stream's (start, end] as (gyr, specific force, quat), else ValueError
+nb::tuple stream_step(HumanStream &s, double start, double end)
+{
+    double out[HUMAN_N_OUT];
+    char message[MESSAGE_SIZE];
+    raise_if(human_stream_step(&s, start, end, out, message, sizeof message), message);
+    Vector gyr = new_vector(3), f = new_vector(3), quat = new_vector(4);
+    std::memcpy(gyr.data(), out, 3 * sizeof(double));
+    std::memcpy(f.data(), out + 3, 3 * sizeof(double));
+    std::memcpy(quat.data(), out + 6, 4 * sizeof(double));
+    return nb::make_tuple(gyr, f, quat);
 }
 
 // ImuModel's fields as ImuModel.vector gives them, in ImuParams' order: delta_n, gyr_offset (3),
@@ -147,16 +171,15 @@ void bind_human_motion(nb::module_ &m)
     m.attr("HUMAN_N_STATES") = HUMAN_N_STATES;
     m.attr("HUMAN_N_OUT") = HUMAN_N_OUT;
     m.def(
-        "human_check",
-        [](double delta_v, double omega_c, double rot_rms, double rot_cutoff, double g) {
-            human_params(delta_v, omega_c, rot_rms, rot_cutoff, g);
-        },
-        nb::arg("delta_v"), nb::arg("omega_c"), nb::arg("rot_rms"), nb::arg("rot_cutoff"), nb::arg("g"),
-        "HumanMotion's refusals: ValueError with the reason.");
+        "profile_check",
+        [](const std::string &name, In<-1> values, double g) { check_profile(name, values.data(), values.shape(0), g); },
+        nb::arg("name"), nb::arg("values"), nb::arg("g"),
+        "A motion profile's parameters (profile_table.py's order) and gravity g (m/s^2) within their plausible "
+        "ranges (profile_table.py's): ValueError naming the parameter, its value and the range.");
     m.def(
         "human_coefficients",
         [](double delta_v, double omega_c, double rot_rms, double rot_cutoff, double g, double fs) {
-            HumanParams p = human_params(delta_v, omega_c, rot_rms, rot_cutoff, g);
+            HumanParams p = {delta_v, omega_c, rot_rms, rot_cutoff, g};
             Vector coef = new_vector(HUMAN_N_COEF);
             human_coefficients(&p, fs, coef.data());
             return coef;
@@ -173,33 +196,39 @@ void bind_human_motion(nb::module_ &m)
         "n samples from n rows of unit normals: state (10: v, omega, q) advanced in place, out (n x 10: "
         "omega, specific force, q).");
 
-    nb::class_<HumanStream>(m, "HumanStream", "HumanMotion sample by sample from a seed (its noise stream "
-                                              "MOTION), equal to HumanMotion.generate with the same seed.")
+    nb::class_<HumanStream>(m, "HumanStream", "HumanMotion on its time grid from a seed (its noise stream "
+                                              "MOTION), over any intervals of time from 0.")
         .def(
             "__init__",
-            [](HumanStream *s, double delta_v, double omega_c, double rot_rms, double rot_cutoff, double g,
-               nb::handle seed) {
-                HumanParams p = human_params(delta_v, omega_c, rot_rms, rot_cutoff, g);
+            [](HumanStream *s, double delta_v, double omega_c, double rot_rms, double rot_cutoff, double grid,
+               double g, nb::handle seed) {
+                HumanParams p = human_params(delta_v, omega_c, rot_rms, rot_cutoff, grid, g);
                 uint64_t value = seed_value(seed);
                 new (s) HumanStream;
-                human_stream_init(s, &p, value);
+                human_stream_init(s, &p, grid, value);
             },
-            nb::arg("delta_v"), nb::arg("omega_c"), nb::arg("rot_rms"), nb::arg("rot_cutoff"), nb::arg("g"),
-            nb::arg("seed"))
+            nb::arg("delta_v"), nb::arg("omega_c"), nb::arg("rot_rms"), nb::arg("rot_cutoff"), nb::arg("grid"),
+            nb::arg("g"), nb::arg("seed"))
         .def(
-            "step",
-            [](HumanStream &s, double t, double h) {
-                (void)t;
-                double out[HUMAN_N_OUT];
-                human_stream_step(&s, h, out);
-                Vector gyr = new_vector(3), f = new_vector(3), quat = new_vector(4);
-                std::memcpy(gyr.data(), out, 3 * sizeof(double));
-                std::memcpy(f.data(), out + 3, 3 * sizeof(double));
-                std::memcpy(quat.data(), out + 6, 4 * sizeof(double));
-                return nb::make_tuple(gyr, f, quat);
+            "step", [](HumanStream &s, double t, double h) { return stream_step(s, t - h, t); }, nb::arg("t"),
+            nb::arg("h"), "Ideal (gyr, specific force, quat) for the interval (t - h, t] (s).")
+        .def(
+            "run",
+            [](HumanStream &s, In<-1> t, Out<-1, HUMAN_N_OUT> out) {
+                same_rows(t.shape(0), out.shape(0), "t and out");
+                char message[MESSAGE_SIZE];
+                double start = s.t;
+                for (size_t k = 0; k < t.shape(0); k++) {
+                    raise_if(human_stream_step(&s, start, t.data()[k], out.data() + HUMAN_N_OUT * k, message,
+                                               sizeof message),
+                             message);
+                    start = t.data()[k];
+                }
             },
-            nb::arg("t"), nb::arg("h"), "Ideal (gyr, specific force, quat) for the interval (t - h, t].")
-        .def_prop_ro("k", [](const HumanStream &s) { return s.k; }, "samples drawn")
+            nb::arg("t"), nb::arg("out").noconvert(),
+            "The intervals from the last one's end to t[0], then (t[k-1], t[k]]: out (n x 10: gyr, specific "
+            "force, quat).")
+        .def_prop_ro("k", [](const HumanStream &s) { return s.k; }, "grid cells drawn")
         .def("__getstate__",
              [](const HumanStream &s) { return nb::bytes(reinterpret_cast<const char *>(&s), sizeof s); })
         .def("__setstate__", [](HumanStream &s, nb::bytes state) {
@@ -207,7 +236,7 @@ void bind_human_motion(nb::module_ &m)
             HumanStream restored;
             std::memcpy(&restored, state.c_str(), sizeof restored);
             const HumanParams &p = restored.params;
-            human_params(p.delta_v, p.omega_c, p.rot_rms, p.rot_cutoff, p.g);
+            human_params(p.delta_v, p.omega_c, p.rot_rms, p.rot_cutoff, restored.grid, p.g);
             new (&s) HumanStream(restored);
         });
 }
