@@ -125,10 +125,11 @@ def broad(refresh: bool) -> None:
     if refresh:
         if not files:
             raise SystemExit(f"no BROAD recordings in {BROAD} (set BROAD_DIR)")
-        run_json("broad", "evaluate", *files)
-        run_json("broad_offline", "evaluate", "--offline", *files)
-        run_json("broad_latency", "evaluate", "--latency", "0.0021", *files)
-        attitude("plot", str(BROAD / "21_undisturbed_fast_combined.mat"), "--out", str(OUT / "plot_21.png"))
+        run_json("broad", "evaluate", "--reference-north", "magnetic", *files)
+        run_json("broad_offline", "evaluate", "--reference-north", "magnetic", "--offline", *files)
+        run_json("broad_latency", "evaluate", "--reference-north", "magnetic", "--latency", "0.0021", *files)
+        attitude("plot", str(BROAD / "21_undisturbed_fast_combined.mat"), "--reference-north", "magnetic", "--out",
+                 str(OUT / "plot_21.png"))
     online, offline = load("broad"), load("broad_offline")
     for name, data in (("broad", online), ("broad_offline", offline)):
         labels = list(data["mean"])

@@ -29,7 +29,7 @@ pytestmark = [pytest.mark.slow,  # every BROAD recording, every estimator and pe
 def table():
     pytest.importorskip("vqf")
     pytest.importorskip("ahrs")
-    return evaluate([str(f) for f in FILES], progress=False)
+    return evaluate([str(f) for f in FILES], progress=False, reference_north="magnetic")
 
 
 def test_print_the_broad_table(table):
@@ -198,7 +198,7 @@ def test_the_imu_trails_the_reference_alike_in_every_file_and_latency_compensati
     (`--latency`), every method's mean inclination error falls and the online ranking holds."""
     lags = np.array(list(table["imu_latency_s"].values()), dtype=float)
     latency = float(lags.mean())
-    carried = evaluate([str(f) for f in FILES], latency=latency, progress=False)["mean"]
+    carried = evaluate([str(f) for f in FILES], latency=latency, progress=False, reference_north="magnetic")["mean"]
     print(f"\nIMU latency {1e3 * lags.min():.2f}–{1e3 * lags.max():.2f} ms; mean inclination with "
           f"--latency {latency:.4f}: " + ", ".join(f"{label} {table['mean'][label]['inclination_rmse_deg']:.3f}° → "
                                                   f"{row['inclination_rmse_deg']:.3f}°" for label, row in carried.items()))

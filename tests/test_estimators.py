@@ -182,9 +182,12 @@ def test_compare_simulates_the_imu_it_is_given(capsys):
         assert main(["compare", "--json", "--profile", "sine_rotation", "--gyro-scale-error", scale]) == 0
         errors.append(json.loads(capsys.readouterr().out)["profiles"]["sine_rotation"]["wiener"]["rms_deg"])
     assert errors[0] < 0.05 < 3 * errors[0] < errors[1]
-    for flag, value in (("--gyro-noise", "-1"), ("--acc-noise", "nan"), ("--gyro-scale-error", "0.5")):
-        assert main(["compare", "--profile", "sine_rotation", flag, value]) == 2
-        assert flag[2:].replace("-", " ").replace("acc", "accelerometer") in capsys.readouterr().err
+    for flag, value, span in (("--gyro-noise", "-1", "[0, 57.2958] °/s/√Hz"), ("--acc-noise", "nan", "[0, 10] m/s²/√Hz"),
+                              ("--gyro-scale-error", "0.5", "[0, 0.5)")):
+        with pytest.raises(SystemExit) as refused:
+            main(["compare", "--profile", "sine_rotation", flag, value])
+        assert refused.value.code == 2
+        assert f"argument {flag}: {value} is outside the plausible {span}" in capsys.readouterr().err
 
 
 def test_bode_writes_a_png(tmp_path):

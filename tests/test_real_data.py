@@ -430,8 +430,10 @@ def test_evaluate_measures_the_imu_latency_and_carries_every_estimate_over_it(tm
     for label in before:
         assert after[label]["inclination_rmse_deg"] == pytest.approx(prompt[label]["inclination_rmse_deg"], abs=0.01)
     assert after["wiener"]["inclination_rmse_deg"] < 0.3 * before["wiener"]["inclination_rmse_deg"]
-    assert main(["evaluate", "--latency", "inf", str(tmp_path / "late.mat")]) == 2
-    assert "latency must be a finite number of seconds" in capsys.readouterr().err
+    with pytest.raises(SystemExit) as refused:
+        main(["evaluate", "--latency", "inf", str(tmp_path / "late.mat")])
+    assert refused.value.code == 2
+    assert "argument --latency: inf is outside the plausible [-0.5, 0.5] s" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize("case", ["no optical reference", "no valid sample during movement", "not a readable",

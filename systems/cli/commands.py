@@ -3,7 +3,10 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
+import re
+import signal
 import sys
 import time
 from pathlib import Path
@@ -13,7 +16,9 @@ import numpy as np
 from attitude_fmu.blocks.methods.registry import METHODS
 from attitude_fmu.blocks.methods.registry import method as known_method
 from attitude_fmu.blocks.pipeline.causal import ESTIMATORS
-from attitude_fmu.blocks.stages.timing import ACC_SAMPLES, GYR_SAMPLES, check_latency
+from attitude_fmu.blocks.params import GYRO_NOISE, TIME_S
+from attitude_fmu.blocks.stages.timing import ACC_SAMPLES, GYR_SAMPLES, MAX_LATENCY_S
+from attitude_fmu.systems.recordings.checks import RATE_RANGE_HZ
 from attitude_fmu.systems.recordings.output import STDIO, check_output, same_file
 from attitude_fmu.systems.recordings.reading import MAX_GAP_S
 from attitude_fmu.systems.recordings.recording import (
@@ -30,7 +35,19 @@ from attitude_fmu.systems.recordings.writing import output_name
 
 EXIT_BAD_INPUT = 2
 EXIT_CHECK_FAILED = 1
+EXIT_SIGNAL = 128  # plus the signal's number, as shells report a process ended by one
 TABLE1_TOLERANCE = 0.07  # simulated cells must lie within ±7 % of eq. 50
+# plausible ranges of the numeric flags (as blocks.params gives the tuning parameters theirs)
+MAX_TIME_S = TIME_S["high"]  # s: durations and gaps; 1e12 s: never
+MAX_SAMPLES = 10**8  # samples of a benchmark's recording or a table1 cell: arrays of them take gigabytes
+TABLE1_FS = 100.0  # Hz: table1's default rate
+MIN_CELL_SAMPLES = 1000  # samples of a table1 cell: fewer give no RMS error worth the name
+MIN_BENCH_SAMPLES = 1000
+MAX_REPEAT = 1000
+MAX_WORKERS = 4096
+MAX_SEED = 2**32 - 1
+MAX_ACC_NOISE = 10.0  # m/s²/√Hz: an accelerometer's white noise, a hundred times a poor MEMS part's
+MAX_SCALE_ERROR = 0.5  # rms scale and misalignment error of the compared gyro (systems.evaluation.compare.imu_model)
 
 
 def _param(text: str) -> tuple[str, float]:
@@ -42,6 +59,27 @@ def _param(text: str) -> tuple[str, float]:
     except ValueError:
         raise argparse.ArgumentTypeError(f"{name}: {value!r} is not a number") from None
     return name.strip(), number
+
+
+def _number(low: float, high: float, unit: str = "", whole: bool = False, above: bool = False,
+            below: bool = False):
+    """An argparse type for a numeric flag: a finite number (whole: an integer) from low to
+    high in unit, each bound included unless above (value > low) or below (value < high);
+    anything else is refused with the range, as --param's values are."""
+    span = f"{'(' if above else '['}{low:g}, {high:g}{')' if below else ']'}{' ' + unit if unit else ''}"
+    kind = "a whole number" if whole else "a number"
+
+    def number(text: str):
+        try:
+            value = int(text) if whole else float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not {kind}; plausible {span}") from None
+        if not (math.isfinite(value) and (value > low if above else value >= low)
+                and (value < high if below else value <= high)):
+            raise argparse.ArgumentTypeError(f"{text} is outside the plausible {span}")
+        return value
+
+    return number
 
 
 def _grid(text: str) -> tuple[str, tuple[float, ...]]:
@@ -56,7 +94,11 @@ def _grid(text: str) -> tuple[str, tuple[float, ...]]:
 def _column(text: str) -> tuple[str, str]:
     name, sep, header = text.partition("=")
     if not sep or not header.strip():
-        raise argparse.ArgumentTypeError(f"expected NAME=HEADER (e.g. gyr_x=Gyr_X), got {text!r}")
+        raise argparse.ArgumentTypeError(f"expected NAME=HEADER (e.g. gyr_x=Gyr_X) or NAME=#N (e.g. gyr_x=#3), "
+                                         f"got {text!r}")
+    if header.strip().startswith("#") and not re.fullmatch(r"#[1-9][0-9]*", header.strip()):
+        raise argparse.ArgumentTypeError(f"a column by position is #N, N counted from 1 (e.g. gyr_x=#3), "
+                                         f"got {text!r}")
     if name.strip() not in KNOWN_COLUMNS + MAT_VARIABLES:
         raise argparse.ArgumentTypeError(f"{name!r} is not a column read; NAME is one of {', '.join(KNOWN_COLUMNS)} "
                                          f"(a CSV) or {', '.join(MAT_VARIABLES)} (a .mat)")
@@ -107,23 +149,28 @@ def _add_json_flag(parser, instead_of: str = "the table") -> None:
 
 
 def _add_input_flags(parser) -> None:
-    parser.add_argument("--fs", type=float, help="sample rate in Hz (required when a CSV has no t column)")
-    parser.add_argument("--gyr-unit", default="rad/s", choices=list(GYR_UNITS), help="gyro unit (default rad/s)")
-    parser.add_argument("--acc-unit", default="m/s2", choices=list(ACC_UNITS),
-                        help="accelerometer unit (default m/s2; g and mg in standard gravity, 9.80665 m/s²)")
-    parser.add_argument("--mag-unit", default="uT", choices=list(MAG_UNITS), help="magnetometer unit (default uT)")
-    parser.add_argument("--t-unit", default="s", choices=list(T_UNITS), help="unit of a CSV's t column (default s)")
+    parser.add_argument("--fs", type=_number(*RATE_RANGE_HZ, "Hz"),
+                        help="sample rate in Hz (required when a CSV has no t column; with one, it places the time "
+                             "stamps on its grid, or the rows are taken as uniform at it)")
+    unit_help = "; a CSV whose header writes another unit is refused without this flag"
+    parser.add_argument("--gyr-unit", choices=list(GYR_UNITS), help=f"gyro unit (default rad/s{unit_help})")
+    parser.add_argument("--acc-unit", choices=list(ACC_UNITS),
+                        help="accelerometer unit (default m/s2; g and mg in standard gravity, 9.80665 m/s²"
+                             f"{unit_help})")
+    parser.add_argument("--mag-unit", choices=list(MAG_UNITS), help=f"magnetometer unit (default uT{unit_help})")
+    parser.add_argument("--t-unit", choices=list(T_UNITS), help=f"unit of a CSV's t column (default s{unit_help})")
     parser.add_argument("--column", type=_column, action="append", default=[], metavar="NAME=HEADER",
-                        help="read the CSV's column HEADER as NAME (t, gyr_x, acc_x, mag_x, ref_q_w, movement, ...), "
-                             "or a .mat's variable HEADER as NAME (imu_gyr, imu_acc, imu_mag, opt_quat, movement, "
-                             "sampling_rate), for a file with other names; repeatable")
+                        help="read the CSV's column HEADER, or #N its N-th column counted from 1, as NAME (t, gyr_x, "
+                             "acc_x, mag_x, ref_q_w, movement, ...), or a .mat's variable HEADER as NAME (imu_gyr, "
+                             "imu_acc, imu_mag, opt_quat, movement, sampling_rate), for a file with other names; "
+                             "repeatable")
     for sensor, what in (("gyr", "gyro"), ("acc", "accelerometer"), ("mag", "magnetometer")):
         parser.add_argument(f"--{sensor}-axes", type=_axes, metavar="MAP",
                             help=f"the {what}'s axes as the file's, signed: y,x,-z takes x from the file's y, y from "
                                  "its x and z from its −z (default x,y,z; one that begins with a minus as "
                                  f"--{sensor}-axes=-x,y,z); a sensor that does not turn as the gyro says is noted "
                                  "with the maps that fit")
-    parser.add_argument("--max-gap", type=float, default=MAX_GAP_S, metavar="S",
+    parser.add_argument("--max-gap", type=_number(0.0, MAX_TIME_S, "s"), default=MAX_GAP_S, metavar="S",
                         help="longest run of samples missing from a CSV's time stamps, or of gyro or "
                              "accelerometer values that are not finite, that is filled in (interpolated "
                              f"linearly; default {MAX_GAP_S:g} s)")
@@ -136,21 +183,15 @@ def _add_input_flags(parser) -> None:
                              "the project's convention); mean: its mean over the sample time before it (a "
                              "recording averaged down to a lower rate, a sensor that averages it as the gyro), "
                              "turned to the sample's time by half the step's rotation")
-    parser.add_argument("--latency", type=float, default=0.0, metavar="S",
+    parser.add_argument("--latency", type=_number(-MAX_LATENCY_S, MAX_LATENCY_S, "s"), default=0.0, metavar="S",
                         help="the IMU's delay behind the motion in seconds (its filters' group delay), counted in "
                              "the means the estimator takes (point samples taken S late, with --gyr-samples point): "
                              "estimates are carried forward over it with the gyro (default 0; attitude evaluate "
                              "measures it against the reference)")
 
 
-def _workers(text: str) -> int:
-    if not text.isdigit() or int(text) < 1:
-        raise argparse.ArgumentTypeError(f"expected a whole number ≥ 1, got {text!r}")
-    return int(text)
-
-
 def _add_cluster_flags(parser, jobs: str) -> None:
-    parser.add_argument("--workers", type=_workers, metavar="N",
+    parser.add_argument("--workers", type=_number(1, MAX_WORKERS, whole=True), metavar="N",
                         help=f"run the {jobs} on a local Dask cluster of N worker processes (default: the number "
                              "of cores); 1 runs them in this process. Results are those of the serial run, in order")
     parser.add_argument("--scheduler", metavar="ADDRESS",
@@ -205,8 +246,10 @@ def build_parser() -> argparse.ArgumentParser:
     est.add_argument("input", nargs="+", help="CSV (t,gyr_x,gyr_y,gyr_z,acc_x,acc_y,acc_z[,mag_x,mag_y,mag_z]; "
                      "separated by commas, semicolons or tabs; - for standard input), Parquet (.parquet, the "
                      "same columns) or BROAD .mat; several: each is estimated with the same flags")
-    est.add_argument("--out", required=True, help="output CSV: t,q_w,q_x,q_y,q_z,g_x,g_y,g_z; or a folder that receives "
-                     "NAME.csv for input NAME.csv or NAME.mat (with several inputs, made if absent)")
+    est.add_argument("--out", required=True, help="output CSV: t,q_w,q_x,q_y,q_z,g_x,g_y,g_z (- for standard output; "
+                     "a file is replaced once complete, a symbolic link's target written, a named pipe or a device "
+                     "such as /dev/null written in place); or a folder that receives NAME.csv for input NAME.csv or "
+                     "NAME.mat (with several inputs, made if absent)")
     est.add_argument("--euler", action="store_true",
                      help="add roll_deg,pitch_deg,yaw_deg to the output (Z-Y-X sequence of q, degrees)")
     est.add_argument("--offsets", action="store_true",
@@ -224,9 +267,13 @@ def build_parser() -> argparse.ArgumentParser:
     ev.add_argument("files", nargs="+", metavar="FILE", help="recordings with a reference")
     _add_method_flags(ev)
     _add_json_flag(ev)
-    ev.add_argument("--start-in-movement", type=float, metavar="S",
+    ev.add_argument("--start-in-movement", type=_number(0.0, MAX_TIME_S, "s"), metavar="S",
                     help="begin each recording S seconds into its movement phase: no rest before, "
                          "a first sample in motion (a test of start-up and offset tracking)")
+    ev.add_argument("--by", metavar="GROUPS", help="also the means over groups of recordings: 'broad' (BROAD's "
+                    "groups, from its trial names) or TABLE.csv:COLUMN (a table of trials: its column name the "
+                    "recordings' file names, COLUMN their group)")
+    _add_reference_flags(ev)
     _add_input_flags(ev)
     _add_real_data_flags(ev)
     _add_cluster_flags(ev, "recordings")
@@ -250,7 +297,7 @@ def build_parser() -> argparse.ArgumentParser:
     out = sw.add_mutually_exclusive_group()
     _add_json_flag(out)
     out.add_argument("--csv", metavar="OUT", help="also write every combination's errors per recording to OUT")
-    sw.add_argument("--start-in-movement", type=float, metavar="S",
+    sw.add_argument("--start-in-movement", type=_number(0.0, MAX_TIME_S, "s"), metavar="S",
                     help="begin each recording S seconds into its movement phase")
     _add_input_flags(sw)
     _add_real_data_flags(sw)
@@ -261,14 +308,18 @@ def build_parser() -> argparse.ArgumentParser:
     pl.add_argument("file", metavar="FILE", help="a recording, as attitude estimate reads it")
     pl.add_argument("--out", required=True, help="PNG to write")
     _add_method_flags(pl)
+    _add_reference_flags(pl)
     _add_real_data_flags(pl)
     _add_input_flags(pl)
 
     t1 = sub.add_parser("table1", help="Rizun's Table 1: analytic (eq. 50) and simulated RMS attitude error")
     _add_json_flag(t1)
-    t1.add_argument("--duration", type=float, default=20000.0, help="simulated seconds per cell (default 20000)")
-    t1.add_argument("--fs", type=float, default=100.0, help="simulation sample rate, Hz (default 100)")
-    t1.add_argument("--seed", type=int, default=0, help="random seed: cell j of row i simulates with seed + 10·i + j "
+    t1.add_argument("--duration", type=_number(0.0, MAX_TIME_S, "s", above=True), default=20000.0,
+                    help="simulated seconds per cell (default 20000)")
+    t1.add_argument("--fs", type=_number(*RATE_RANGE_HZ, "Hz"), default=TABLE1_FS,
+                    help=f"simulation sample rate, Hz (default {TABLE1_FS:g})")
+    t1.add_argument("--seed", type=_number(0, MAX_SEED, whole=True), default=0,
+                    help="random seed: cell j of row i simulates with seed + 10·i + j "
                     "(default 0)")
     _add_cluster_flags(t1, "cells")
 
@@ -278,6 +329,10 @@ def build_parser() -> argparse.ArgumentParser:
     _add_cluster_flags(vf, "co-simulations (profile × method)")
     vf.add_argument("--python", action="store_true", help="also run the pythonfmu chain and hold its estimator "
                     "outputs to the native chain's within 1e-9 (minutes instead of seconds)")
+    vf.add_argument("--platforms", default="host", help="the native FMUs hold these platforms' binaries too, cross-"
+                    "compiled where missing (needs ziglang): host (the default), all, or a comma-separated list of "
+                    "x86_64-linux, aarch64-linux, x86_64-windows, x86_64-darwin, aarch64-darwin; the chain runs "
+                    "the x86_64-linux one (glibc 2.17) where it is asked for")
     ss = sub.add_parser("ssp", help="write verify's SSP of each profile × method, the FMUs inside, for other tools")
     ss.add_argument("--out", type=Path, required=True, help="folder for the files <profile>_<method>.ssp")
     _add_verify_flags(ss)
@@ -285,15 +340,19 @@ def build_parser() -> argparse.ArgumentParser:
     chain.add_argument("--native", dest="chain", action="store_const", const="native", default="native",
                        help="the FMUs in C (DIR/native; default)")
     chain.add_argument("--python", dest="chain", action="store_const", const="python", help="the pythonfmu FMUs")
+    ss.add_argument("--fmi-version", choices=("2.0", "3.0"), default="2.0",
+                    help="the FMUs' FMI version (default 2.0); 3.0: the native FMI 3.0 FMUs (DIR/native/fmi3)")
 
     cp = sub.add_parser("compare", help="every estimator and the peers vqf, madgwick on every motion profile")
     cp.add_argument("--profile", action="append", help="only this profile (repeatable)")
     _add_json_flag(cp)
-    cp.add_argument("--gyro-noise", type=float, default=0.02, metavar="DEG_S_RTHZ",
+    cp.add_argument("--gyro-noise", type=_number(0.0, math.degrees(GYRO_NOISE["high"]), "°/s/√Hz"), default=0.02,
+                    metavar="DEG_S_RTHZ",
                     help="the simulated gyro's white noise, °/s/√Hz (default 0.02)")
-    cp.add_argument("--acc-noise", type=float, default=0.002, metavar="M_S2_RTHZ",
+    cp.add_argument("--acc-noise", type=_number(0.0, MAX_ACC_NOISE, "m/s²/√Hz"), default=0.002, metavar="M_S2_RTHZ",
                     help="the simulated accelerometer's white noise, m/s²/√Hz (default 0.002)")
-    cp.add_argument("--gyro-scale-error", type=float, default=0.0, metavar="FRACTION",
+    cp.add_argument("--gyro-scale-error", type=_number(0.0, MAX_SCALE_ERROR, below=True), default=0.0,
+                    metavar="FRACTION",
                     help="rms of each element of the simulated gyro's scale-factor and misalignment matrix, "
                          "drawn once (1 = 100 %%; default 0, an ideal scale)")
     cp.add_argument("--offline", action="store_true",
@@ -307,7 +366,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     bn = sub.add_parser("bench", help="samples per second of the batch estimator, vqf and ahrs Madgwick")
     _add_json_flag(bn, "the lines")
-    bn.add_argument("--samples", type=int, help="samples of the recording (default 100000; with --io 1000000)")
+    bn.add_argument("--samples", type=_number(MIN_BENCH_SAMPLES, MAX_SAMPLES, whole=True),
+                    help="samples of the recording (default 100000; with --io 1000000)")
     bn.add_argument("--fmu", action="store_true",
                     help="per-step cost of AttitudeEstimator.fmu against a no-op FMU of the same interface, pythonfmu "
                          "and native, under fmpy; and of the native against the pythonfmu one in a C host")
@@ -315,13 +375,14 @@ def build_parser() -> argparse.ArgumentParser:
                     help="attitude estimate end to end on a 9D recording at 1 kHz (--samples, default here 1000000), "
                          "CSV to CSV and Parquet to Parquet, against pandas read_csv + vqf 9D + pandas to_csv; "
                          "peak memory (needs pip install 'attitude-fmu[bench]')")
-    bn.add_argument("--repeat", type=int, default=10, help="interleaved rounds; each method's best run counts "
+    bn.add_argument("--repeat", type=_number(1, MAX_REPEAT, whole=True), default=10,
+                    help="interleaved rounds; each method's best run counts "
                     "(default 10; with --io at most 3)")
-    bn.add_argument("--workers", type=_workers, metavar="N",
+    bn.add_argument("--workers", type=_number(1, MAX_WORKERS, whole=True), metavar="N",
                     help="instead: wall time of attitude evaluate on --recordings and of attitude table1 on a local "
                          "cluster of N worker processes against one process, start-up included, and their ratio")
     bn.add_argument("--recordings", nargs="+", default=[], metavar="FILE", help="with --workers: evaluate's files")
-    bn.add_argument("--duration", type=float, default=20000.0,
+    bn.add_argument("--duration", type=_number(0.0, MAX_TIME_S, "s", above=True), default=20000.0,
                     help="with --workers: table1's simulated seconds per cell (default 20000)")
     return parser
 
@@ -412,7 +473,9 @@ def _estimate_one(args, path, out, prefix: str) -> None:
         clock = now
 
     rec = read_recording(path, **_read_options(args))
-    progress(f"read {len(rec.gyr)} samples at {rec.fs:g} Hz from {path}")
+    filled = 0 if rec.filled is None else int(rec.filled.sum())  # rows put into gaps, not the input's
+    progress(f"read {len(rec.gyr) - filled} samples at {rec.fs:g} Hz from {path}"
+             + (f", and filled {filled} more into the gaps of its time stamps" if filled else ""))
     print_notes(rec.notes + ([field_norm_note(rec)] if args.heading == "mag" else []))
     result = estimate(rec.gyr, rec.acc, rec.fs, args.method, dict(args.param), offline=args.offline,
                       gyro_offset=args.gyro_offset == "on", mag=rec.mag if args.heading == "mag" else None,
@@ -449,6 +512,23 @@ def _mag_delay_text(result) -> str:
     return f"its delay behind the gyro {delay:.1f} ms ({how}; --param mag_delay=S sets it)"
 
 
+def _add_reference_flags(parser) -> None:
+    """--reference-north and --align: how a reference is brought to the estimate's frames."""
+    parser.add_argument("--reference-north", choices=["other", "magnetic"], default="other",
+                        help="other (default): the reference's north is its own, and each estimate's constant "
+                             "heading offset from it is removed before the heading error; magnetic: the reference "
+                             "is aligned to magnetic north (BROAD's): the offset counts")
+    parser.add_argument("--align", action="store_true",
+                        help="bring the reference into the IMU's frames first: its lag, the rotation between the "
+                             "IMU and the reference's body, its up axis and heading offset, found from the angular "
+                             "rates and reported (JSON: alignment); refused where the rates do not match")
+
+
+def _table_labels(result) -> list[str]:
+    """Every label of any recording's table, in the order they first appear."""
+    return list(dict.fromkeys(label for table in result["recordings"].values() for label in table))
+
+
 def cmd_evaluate(args) -> int:
     from attitude_fmu.systems.evaluation.evaluate import METRICS, evaluate
 
@@ -461,22 +541,38 @@ def cmd_evaluate(args) -> int:
     with _jobs(args) as jobs:
         result = evaluate(args.files, args.method, dict(args.param), args.offline, args.gyro_offset == "on",
                           args.heading == "mag", start_in_movement=args.start_in_movement,
-                          read_options=_read_options(args), **_timing(args), jobs=jobs)
+                          read_options=_read_options(args), **_timing(args), jobs=jobs, align=args.align,
+                          reference_north=args.reference_north, by=args.by)
     status = EXIT_BAD_INPUT if "failed" in result else 0
     if args.json:
         print(json.dumps(result, indent=2))
         return status
     if not result["recordings"]:
         return status
-    labels = list(result["mean"])
-    print("RMSE over the movement phase, degrees: inclination / heading / total; IMU lag behind the reference, ms")
+    labels = _table_labels(result)
+    lags = {name: a["lag_s"] for name, a in result["alignment"].items()} if args.align else result["imu_latency_s"]
+    north = "magnetic north kept" if args.reference_north == "magnetic" else "each one's heading offset removed"
+    print(f"RMSE over the movement phase, degrees: inclination / heading / total ({north}); "
+          f"{'the reference' if args.align else 'the IMU'} lags {'the IMU' if args.align else 'the reference'}, ms")
     print(f"{'recording':>45} " + " ".join(f"{label:>22}" for label in labels) + f" {'lag':>6}")
-    rows = list(result["recordings"].items()) + [("mean", result["mean"])]
-    for name, table in rows:
-        cells = " ".join(f"{'/'.join(format(table[l][m], '.2f') for m in reversed(METRICS)):>22}" for l in labels)
-        lag = result["imu_latency_s"].get(name)
-        print(f"{name:>45} {cells} {'' if name == 'mean' else '     —' if lag is None else format(1e3 * lag, '6.2f')}"
-              .rstrip())
+
+    def cells(table):  # "—" where a table lacks the label (a file without a magnetometer has no vqf_9d)
+        return " ".join(f"{'/'.join(format(table[l][m], '.2f') for m in reversed(METRICS)) if l in table else '—':>22}"
+                        for l in labels)
+
+    for name, table in result["recordings"].items():
+        lag = lags.get(name)
+        print(f"{name:>45} {cells(table)} {'     —' if lag is None else format(1e3 * lag, '6.2f')}")
+    print(f"{'mean':>45} {cells(result['mean'])}")
+    for group, found in result.get("by_group", {}).items():
+        name = f"{group} ({found['trials']})"
+        print(f"{name:>45} {cells(found['mean'])}")
+    if len(labels) > len(result["mean"]):
+        print("—: a column not every recording has is left out of the mean (vqf_9d needs a magnetometer)")
+    for name, found in result.get("alignment", {}).items():
+        print(f"{name}: aligned: lag {found['lag_s']:+.4f} s, mounting [w, x, y, z] "
+              f"{', '.join(format(c, '.4f') for c in found['mounting_quat'])}, up {found['up_axis']}, heading offset "
+              f"{found['heading_offset_deg']:.2f}°, misfit {found['misfit']:.3f}")
     return status
 
 
@@ -505,7 +601,8 @@ def cmd_plot(args) -> int:
 
     _check_out(args.out, args.file, figure=True)
     result = plot_recording(args.file, args.out, args.method, dict(args.param), args.offline,
-                            args.gyro_offset == "on", args.heading == "mag", _read_options(args), **_timing(args))
+                            args.gyro_offset == "on", args.heading == "mag", _read_options(args), **_timing(args),
+                            align=args.align, reference_north=args.reference_north)
     if not result:
         print(f"attitude: wrote {args.out} (no reference to measure errors against: the estimate's roll, pitch "
               "and yaw over time)", file=sys.stderr)
@@ -519,8 +616,7 @@ def cmd_plot(args) -> int:
 def cmd_table1(args) -> int:
     from attitude_fmu.systems.evaluation.experiments import table1
 
-    if not (args.duration > 0 and args.fs > 0):
-        raise ValueError("--duration and --fs must be positive")
+    _check_cell_samples(args.duration, args.fs)
     with _jobs(args) as jobs:
         rows = table1(duration=args.duration, fs=args.fs, seed=args.seed, jobs=jobs)
     failed = [
@@ -548,6 +644,15 @@ def cmd_table1(args) -> int:
     return 0
 
 
+def _check_cell_samples(duration: float, fs: float) -> None:
+    """Refuse a table1 cell of duration s at fs Hz with fewer than MIN_CELL_SAMPLES or more
+    than MAX_SAMPLES samples."""
+    samples = duration * fs
+    if not MIN_CELL_SAMPLES <= samples <= MAX_SAMPLES:
+        raise ValueError(f"--duration {duration:g} s at {fs:g} Hz gives {samples:.3g} samples per table1 cell; "
+                         f"the plausible range is [{MIN_CELL_SAMPLES:g}, {MAX_SAMPLES:g}]")
+
+
 def _verified_fmus(args) -> Path:
     """The FMU folder, built where needed, once the profiles and methods asked for are known."""
     from attitude_fmu.systems.fmi.build import ensure_built
@@ -564,7 +669,10 @@ def _verified_fmus(args) -> Path:
 def cmd_ssp(args) -> int:
     from attitude_fmu.systems.fmi.verify import write_verify_ssps
 
-    for path in write_verify_ssps(_verified_fmus(args), args.out, args.profile, args.method, args.chain):
+    if args.fmi_version == "3.0" and args.chain == "python":
+        raise ValueError("the pythonfmu FMUs are FMI 2.0 only: --fmi-version 3.0 takes the native ones")
+    chain = "fmi3" if args.fmi_version == "3.0" else args.chain
+    for path in write_verify_ssps(_verified_fmus(args), args.out, args.profile, args.method, chain):
         print(path)
     return 0
 
@@ -575,7 +683,7 @@ def cmd_verify(args) -> int:
 
     fmu_dir = _verified_fmus(args)
     with _jobs(args) as jobs:
-        rows = verify(fmu_dir, args.profile, args.method, python=args.python, jobs=jobs)
+        rows = verify(fmu_dir, args.profile, args.method, python=args.python, jobs=jobs, platforms=args.platforms)
     if args.json:
         print(json.dumps({"rows": rows}, indent=2))
     else:
@@ -637,9 +745,8 @@ def cmd_bench(args) -> int:
     from attitude_fmu.systems.evaluation.bench import bench
 
     args.samples = args.samples or (1_000_000 if args.io else 100_000)
-    if args.samples < 1000 or args.repeat < 1:
-        raise ValueError("--samples must be ≥ 1000 and --repeat ≥ 1")
     if args.workers:
+        _check_cell_samples(args.duration, TABLE1_FS)  # the table1 it runs has the default rate
         from attitude_fmu.systems.evaluation.bench import bench_workers
 
         result = bench_workers(args.recordings, args.workers, args.duration)
@@ -691,17 +798,20 @@ def cmd_bench(args) -> int:
 
 
 def main(argv=None) -> int:
-    args = build_parser().parse_args(argv)
-    handler = {"estimate": cmd_estimate, "evaluate": cmd_evaluate, "sweep": cmd_sweep, "plot": cmd_plot,
-               "table1": cmd_table1, "verify": cmd_verify, "ssp": cmd_ssp, "compare": cmd_compare,
-               "bode": cmd_bode, "bench": cmd_bench}[args.command]
     try:
-        if hasattr(args, "latency"):
-            check_latency(args.latency)  # before any input is read
+        args = build_parser().parse_args(argv)
+        handler = {"estimate": cmd_estimate, "evaluate": cmd_evaluate, "sweep": cmd_sweep, "plot": cmd_plot,
+                   "table1": cmd_table1, "verify": cmd_verify, "ssp": cmd_ssp, "compare": cmd_compare,
+                   "bode": cmd_bode, "bench": cmd_bench}[args.command]
         return handler(args)
     except (ValueError, OSError, RuntimeError) as exc:
         print(f"attitude: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    except KeyboardInterrupt as exc:  # SIGINT anywhere; SIGTERM or SIGHUP during a write (Interrupted)
+        signum = getattr(exc, "signum", signal.SIGINT)
+        print(f"attitude: interrupted by {signal.Signals(signum).name}; no output was left half-written",
+              file=sys.stderr)
+        return EXIT_SIGNAL + signum
 
 
 def entry_point() -> None:

@@ -3,6 +3,7 @@ without a reference, the estimate's angles over time."""
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 from scipy import signal
@@ -14,6 +15,8 @@ from attitude_fmu.blocks.methods.registry import design_delta_v
 from attitude_fmu.blocks.methods.registry import method as get_method
 from attitude_fmu.blocks.pipeline.batch import check_options, estimate
 from attitude_fmu.blocks.pipeline.causal import split_params
+from attitude_fmu.systems.evaluation.alignment import align as align_reference
+from attitude_fmu.systems.evaluation.alignment import heading_offset, without_heading_offset
 from attitude_fmu.systems.recordings.output import save_figure
 from attitude_fmu.systems.recordings.reading import read_recording
 from attitude_fmu.systems.recordings.recording import RecordingError, print_notes
@@ -22,7 +25,8 @@ from attitude_fmu.systems.recordings.writing import euler_degrees
 
 def plot_recording(path, out, method: str = "wiener", params=None, offline: bool = False,
                    gyro_offset: bool = True, heading: bool = True, read_options=None, latency: float = 0.0,
-                   gyr_samples: str = "mean", acc_samples: str = "point") -> dict:
+                   gyr_samples: str = "mean", acc_samples: str = "point", align: bool = False,
+                   reference_north: str = "other") -> dict:
     """Draw the error of method on a recording with a reference into out (PNG): the
     inclination error over time, with heading (and a magnetometer in the recording) the
     heading error with the samples the disturbance guard refused shaded and the times a
@@ -31,7 +35,9 @@ def plot_recording(path, out, method: str = "wiener", params=None, offline: bool
     movement phase (Recording.evaluated). A recording without a reference gets the
     estimate's roll, pitch and yaw over time instead (and the gyro offset estimate), and
     an empty dict. read_options: keyword arguments of read_recording (its notes go to
-    standard error); latency (s), gyr_samples and acc_samples: as blocks.pipeline.batch.estimate's."""
+    standard error); latency (s), gyr_samples and acc_samples: as blocks.pipeline.batch.estimate's;
+    align and reference_north as systems.evaluation.evaluate.evaluate's (with align, the
+    alignment found is returned under "alignment")."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -51,6 +57,15 @@ def plot_recording(path, out, method: str = "wiener", params=None, offline: bool
     if valid is None:
         _plot_angles(plt, rec.name, label, t, est, out)
         return {}
+    found = None
+    if align:
+        found, quat_ref = align_reference(rec, est.quat)
+        rec = replace(rec, quat_ref=quat_ref)
+        valid = rec.evaluated()
+    if reference_north != "magnetic":  # the reference's own north: the estimate's constant heading offset removed
+        quat_ref = rec.quat_ref.copy()
+        quat_ref[valid] = without_heading_offset(quat_ref[valid], heading_offset(est.quat[valid], quat_ref[valid]))
+        rec = replace(rec, quat_ref=quat_ref)
     inclination, heading_error = np.full(len(rec.gyr), np.nan), np.full(len(rec.gyr), np.nan)
     _, heading_error[valid], inclination[valid] = np.degrees(quaternion_errors(est.quat[valid], rec.quat_ref[valid]))
     # horizontal earth-frame components of the estimated up: small-angle tilt errors, rad
@@ -84,7 +99,7 @@ def plot_recording(path, out, method: str = "wiener", params=None, offline: bool
     fig.tight_layout()
     save_figure(fig, out, dpi=110)
     plt.close(fig)
-    return rmse
+    return rmse if found is None else {**rmse, "alignment": found.to_json()}
 
 
 def _plot_angles(plt, name, label, t, est, out) -> None:

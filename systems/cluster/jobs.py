@@ -13,12 +13,18 @@ from __future__ import annotations
 
 import importlib.metadata
 import os
+import socket
+import struct
 import sys
 import uuid
 from dataclasses import dataclass
 
 JOB_ERRORS = (ValueError, OSError, RuntimeError)  # a job's own failure, as the CLI reports them
 CONNECT_TIMEOUT_S = 10.0  # for --scheduler ADDRESS
+GREETING_TIMEOUT_S = 5.0  # a Dask scheduler's first message follows the connection at once
+MAX_GREETING_BYTES = 1 << 20  # its length comes first; a handshake takes a few hundred bytes
+SCHEDULER_SCHEMES = ("tcp", "tls", "ws", "wss")  # a scheduler in another process; inproc:// is one in this process
+DEFAULT_SCHEDULER_PORT = 8786
 WORKER_PLUGIN = "attitude-fmu-worker-exit"
 
 
@@ -57,6 +63,8 @@ class Jobs:
     def __init__(self, workers: int = 1, scheduler: str | None = None, bar: bool = True):
         if scheduler is None and not (isinstance(workers, int) and workers >= 1):
             raise ValueError(f"the number of workers must be a whole number ≥ 1, got {workers!r}")
+        if scheduler is not None:
+            scheduler_endpoint(scheduler)  # a scheme this program cannot use: refused before any work
         self.workers, self.scheduler, self.bar = workers, scheduler, bar
         self.failed: list[str] = []
         self.client = None
@@ -138,10 +146,12 @@ class Jobs:
                                              scheduler_kwargs={"dashboard": False})
             self.client = Client(self._cluster)
         else:
+            check_scheduler(self.scheduler)
             try:
                 self.client = Client(self.scheduler, timeout=CONNECT_TIMEOUT_S)
-            except (OSError, TimeoutError) as exc:
-                raise RuntimeError(f"cannot reach the Dask scheduler at {self.scheduler}: {exc}") from None
+            except Exception as exc:  # Dask raises many types: the address, the handshake, the security settings
+                raise RuntimeError(f"cannot connect to the Dask scheduler at {self.scheduler}: "
+                                   f"{str(exc) or type(exc).__name__}") from None
             self._check_workers()
         self.client.register_plugin(WorkerExit(always=self._cluster is not None), name=WORKER_PLUGIN)
         return self.client
@@ -175,3 +185,57 @@ class Jobs:
             rest = "the others completed" if len(failed) < len(outcomes) else "none completed"
             print(f"attitude: error: {len(failed)} of {len(outcomes)} {what} failed "
                   f"({', '.join(name for _, name, _ in failed)}); {rest}", file=sys.stderr)
+
+
+def scheduler_endpoint(address: str) -> tuple[str, str, int]:
+    """(scheme, host, port) of a --scheduler address (tcp:// when it has no scheme, port
+    DEFAULT_SCHEDULER_PORT when it has none); a scheme other than SCHEDULER_SCHEMES, or one
+    this installation of Dask lacks, is refused by name (ValueError)."""
+    from distributed.comm.addressing import parse_address, parse_host_port
+    from distributed.comm.registry import backends
+
+    try:
+        scheme, location = parse_address(address)
+        host, port = parse_host_port(location, DEFAULT_SCHEDULER_PORT)
+    except ValueError as exc:
+        raise ValueError(f"--scheduler {address}: not an address of a Dask scheduler ({exc}); give "
+                         "tcp://HOST:PORT") from None
+    if scheme == "inproc":
+        raise ValueError(f"--scheduler {address}: inproc:// names a scheduler inside one Python process, which "
+                         "a command cannot reach; give its tcp://HOST:PORT address")
+    if scheme not in SCHEDULER_SCHEMES or scheme not in backends:
+        usable = ", ".join(f"{s}://" for s in SCHEDULER_SCHEMES if s in backends)
+        raise ValueError(f"--scheduler {address}: the scheme {scheme}:// is not one to reach a Dask scheduler "
+                         f"through; give {usable} HOST:PORT")
+    return scheme, host, int(port)
+
+
+def check_scheduler(address: str) -> None:
+    """Refuse (RuntimeError), within CONNECT_TIMEOUT_S + GREETING_TIMEOUT_S, a tcp:// address
+    where no Dask scheduler listens: nothing there, or a server that does not greet as a
+    scheduler does, with the length of its first message (an HTTP server such as Dask's
+    dashboard sends nothing until asked). Other schemes are left to Dask's own timeout."""
+    scheme, host, port = scheduler_endpoint(address)
+    if scheme != "tcp":
+        return
+    try:
+        connection = socket.create_connection((host, port), timeout=CONNECT_TIMEOUT_S)
+    except OSError as exc:  # refused, no such host, a timeout
+        raise RuntimeError(f"cannot reach the Dask scheduler at {address}: {exc.strerror or exc}") from None
+    greeting = b""
+    with connection:
+        connection.settimeout(GREETING_TIMEOUT_S)
+        try:
+            while len(greeting) < 8:
+                part = connection.recv(8 - len(greeting))
+                if not part:
+                    break
+                greeting += part
+        except OSError:  # a timeout: the server waits to be spoken to
+            pass
+    length = struct.unpack("<Q", greeting)[0] if len(greeting) == 8 else 0
+    if not 0 < length <= MAX_GREETING_BYTES:
+        said = f"it sent {greeting!r}" if greeting else f"it sent nothing in {GREETING_TIMEOUT_S:g} s"
+        raise RuntimeError(f"{address} is no Dask scheduler: {said} (a web server, such as Dask's dashboard, "
+                           f"answers so; the scheduler listens on another port, {DEFAULT_SCHEDULER_PORT} "
+                           "unless set otherwise)")

@@ -16,7 +16,10 @@ from attitude_fmu.blocks.pipeline.batch import check_options, estimate
 from attitude_fmu.blocks.stages.delays import best_shift
 from attitude_fmu.blocks.stages.timing import carry_forward_rows, interval_ends, interval_means
 from attitude_fmu.systems.cluster.jobs import Failure, Jobs
+from attitude_fmu.systems.evaluation.alignment import align as align_reference
+from attitude_fmu.systems.evaluation.alignment import heading_offset, without_heading_offset
 from attitude_fmu.systems.evaluation.compare import peer_quaternions
+from attitude_fmu.systems.evaluation.groups import groups
 from attitude_fmu.systems.recordings.reading import read_recording
 from attitude_fmu.systems.recordings.recording import Recording, print_notes
 
@@ -30,14 +33,27 @@ REFERENCE_ORDERS = {  # a reference stored otherwise, as its columns w,x,y,z rea
 }
 REFERENCE_RATIO = 4.0  # how much better another order must fit the estimate to be noted
 REFERENCE_NOTE_DEG = 5.0  # nor is anything said below this inclination RMSE (deg) as the reference is read
+REFERENCE_NORTH = ("other", "magnetic")  # the reference's north: another (its offset removed), or magnetic
 
 
-def errors_on_movement(quat, rec: Recording) -> dict:
+def magnetic_north(reference_north: str) -> bool:
+    """Whether a reference has the estimate's north: "magnetic" (BROAD's references) yes, "other" no."""
+    if reference_north not in REFERENCE_NORTH:
+        raise ValueError(f"reference north must be one of {', '.join(REFERENCE_NORTH)}, got {reference_north!r}")
+    return reference_north == "magnetic"
+
+
+def errors_on_movement(quat, rec: Recording, magnetic_north: bool = True) -> dict:
     """RMSE (deg) of total, heading and inclination error over Recording.evaluated (the
     movement phase where the reference is finite; BROAD's definitions, see
-    blocks.errors.quaternion_errors)."""
-    ok = rec.evaluated()
-    errors = quaternion_errors(quat[ok], rec.quat_ref[ok])
+    blocks.errors.quaternion_errors). magnetic_north False: the reference's north is not the
+    estimate's, so the constant heading offset between them (their turn about the vertical,
+    circular mean over those samples: systems.evaluation.alignment.heading_offset) is removed first."""
+    ok = rec.evaluated() & np.isfinite(quat).all(axis=1)
+    ref = rec.quat_ref[ok]
+    if not magnetic_north:
+        ref = without_heading_offset(ref, heading_offset(quat[ok], ref))
+    errors = quaternion_errors(quat[ok], ref)
     return {name: math.degrees(float(np.sqrt(np.mean(e**2)))) for name, e in zip(METRICS, errors)}
 
 
@@ -92,36 +108,47 @@ def method_label(method: str, offline: bool) -> str:
 
 def evaluate_recording(rec: Recording, method: str = "wiener", params=None, offline: bool = False,
                        gyro_offset: bool = True, use_mag: bool = True, latency: float = 0.0,
-                       peers: bool = True, threads: int | None = None) -> dict:
+                       peers: bool = True, threads: int | None = None, align: bool = False,
+                       magnetic: bool = False, alignment: dict | None = None) -> dict:
     """{method label: {metric: value}} for one recording; with a magnetometer (and use_mag)
     the method's heading comes from it, and vqf's 9D estimate is added as "vqf_9d". A
     reference that fits far better in another order is noted in rec.notes
     (reference_order_note).
     latency (s): every estimate, the peers' too, is carried forward over the IMU's delay
     (blocks.stages.timing; the peers' with the raw gyro). peers=False: the method's alone.
-    threads: the estimate's (blocks.pipeline.batch.estimate; None: its own choice)."""
+    threads: the estimate's (blocks.pipeline.batch.estimate; None: its own choice).
+    align: the reference is first brought into the IMU's frames (systems.evaluation.alignment:
+    lag, mounting, up axis, heading offset), what was found put into the dict alignment when
+    given (Alignment.to_json). magnetic: the reference's north is magnetic north, the
+    estimate's; else (the default) each estimate's constant heading offset from the reference is
+    removed before its heading error (errors_on_movement)."""
     rec.evaluated()  # refuses a recording without a usable reference before any work
     label = method_label(method, offline)
     mag = rec.mag if use_mag else None
     est = estimate(rec.gyr, rec.acc, rec.fs, method, params, offline=offline, gyro_offset=gyro_offset, mag=mag,
                    latency=latency, threads=threads)
+    if align:
+        found, quat_ref = align_reference(rec, est.quat)
+        rec = replace(rec, quat_ref=quat_ref)
+        if alignment is not None:
+            alignment.update(found.to_json())
     gyr, acc = np.ascontiguousarray(rec.gyr), np.ascontiguousarray(rec.acc)
 
     def peer(quat):
         quat = np.array(quat, dtype=float)
         if latency:
             carry_forward_rows(quat, np.zeros_like(gyr), gyr, latency)
-        return errors_on_movement(quat, rec)
+        return errors_on_movement(quat, rec, magnetic)
 
-    note = reference_order_note(rec, est.quat)
+    note = None if align else reference_order_note(rec, est.quat)
     if note:
         rec.notes.append(note)
     if not peers:
-        return {label: errors_on_movement(est.quat, rec)}
+        return {label: errors_on_movement(est.quat, rec, magnetic)}
     import vqf as vqf_module  # peers: the test extra (or [peers])
 
     table = {
-        label: errors_on_movement(est.quat, rec),
+        label: errors_on_movement(est.quat, rec, magnetic),
         "vqf": peer(peer_quaternions("vqf", gyr, acc, rec.fs)),
         "vqf_offline": peer(peer_quaternions("vqf_offline", gyr, acc, rec.fs)),
         "madgwick": peer(peer_quaternions("madgwick", gyr, acc, rec.fs)),
@@ -148,11 +175,14 @@ class Setup:
     gyr_samples: str = "mean"
     acc_samples: str = "point"
     threads: int | None = None  # the estimate's (job_threads)
+    align: bool = False
+    reference_north: str = "other"
 
     def check(self) -> None:
         """Refuse the options before any file is read (blocks.pipeline.batch.check_options)."""
         check_options(self.method, self.params, self.offline, self.gyro_offset, self.use_mag, self.latency,
                       self.gyr_samples, self.acc_samples)
+        magnetic_north(self.reference_north)
 
 
 def read_prepared(path, setup: Setup) -> Recording:
@@ -170,14 +200,19 @@ def read_prepared(path, setup: Setup) -> Recording:
 
 def evaluate_file(path, setup: Setup, peers: bool = True) -> dict:
     """One recording's job: {"table": {label: metrics}, "imu_latency_s": seconds or None,
-    "notes": [how it was read]}; peers=False: the method's errors alone ("table" holds
-    the method's label only, imu_latency_s None), as a sweep needs them."""
+    "notes": [how it was read]}, and with setup.align "alignment" (Alignment.to_json; the
+    IMU's latency is then its lag_s, imu_latency_s None); peers=False: the method's errors
+    alone ("table" holds the method's label only, imu_latency_s None), as a sweep needs them."""
     rec = read_prepared(path, setup)
+    alignment = {} if setup.align else None
     table = evaluate_recording(rec, setup.method, setup.params, setup.offline, setup.gyro_offset, setup.use_mag,
-                               setup.latency, peers, setup.threads)
+                               setup.latency, peers, setup.threads, setup.align,
+                               magnetic_north(setup.reference_north), alignment)
     notes = rec.notes + ([f"{rec.name}: no movement flag; errors over every sample with a reference"]
                          if rec.movement is None else [])
-    return {"table": table, "imu_latency_s": imu_latency(rec) if peers else None, "notes": notes}
+    result = {"table": table, "imu_latency_s": imu_latency(rec) if peers and not setup.align else None,
+              "notes": notes}
+    return result if alignment is None else {**result, "alignment": alignment}
 
 
 def job_threads(jobs: Jobs) -> int | None:
@@ -204,10 +239,20 @@ def mean_over(tables) -> dict:
             for label in tables[0] if label in labels}
 
 
+def by_group(recordings: dict, by: str) -> dict:
+    """{group: {"trials": n, "mean": {label: {metric: mean}}}} over the recordings' tables (name →
+    table) of each group (systems.evaluation.groups.groups: by "broad" or "TABLE.csv:COLUMN")."""
+    of = groups(recordings, by)
+    return {group: {"trials": sum(g == group for g in of.values()),
+                    "mean": mean_over(recordings[name] for name, g in of.items() if g == group)}
+            for group in sorted(set(of.values()))}
+
+
 def evaluate(paths, method: str = "wiener", params=None, offline: bool = False, gyro_offset: bool = True,
              use_mag: bool = True, progress: bool = True, start_in_movement: float | None = None,
              read_options=None, latency: float = 0.0, gyr_samples: str = "mean", acc_samples: str = "point",
-             jobs: Jobs | None = None) -> dict:
+             jobs: Jobs | None = None, align: bool = False, reference_north: str = "other",
+             by: str | None = None) -> dict:
     """{"recordings": {name: {label: metrics}}, "mean": {label: metrics}, "imu_latency_s":
     {name: seconds or None}} over the files (imu_latency: the IMU's delay behind the
     reference, measured, whatever latency (s) the estimates were carried forward by), and
@@ -222,11 +267,19 @@ def evaluate(paths, method: str = "wiener", params=None, offline: bool = False, 
     name is recording_names'. Each file is a job of jobs (systems.cluster.jobs.Jobs; default:
     this process, a bar when progress); results are those of the serial run, in the files'
     order. progress also prints how each file was read where it matters (time stamps, no
-    movement flag)."""
+    movement flag).
+    align: each reference is first brought into its IMU's frames (lag, mounting, up, heading
+    offset: systems.evaluation.alignment), what was found under "alignment": {name: {lag_s,
+    mounting_quat, up_axis, heading_offset_deg, misfit}}. reference_north: "other" (each
+    estimate's constant heading offset from the reference is removed before its heading error)
+    or "magnetic" (the reference's north is magnetic north, as BROAD's: kept). by: the means over each group of recordings too, under "by_group"
+    (by_group)."""
     jobs = jobs or Jobs(bar=progress)
     setup = Setup(method, params, offline, gyro_offset, use_mag, start_in_movement, read_options, latency,
-                  gyr_samples, acc_samples, job_threads(jobs))
+                  gyr_samples, acc_samples, job_threads(jobs), align, reference_north)
     setup.check()
+    if by:
+        groups([], by)  # a table that cannot group is refused before any recording is read
     names = recording_names(paths)
     results = jobs.map(evaluate_file, [(str(Path(path).absolute()), setup) for path in paths], list(map(str, paths)),
                        "recordings")
@@ -241,6 +294,10 @@ def evaluate(paths, method: str = "wiener", params=None, offline: bool = False, 
               f"(now {latency:g})", file=sys.stderr)
     recordings = {name: result["table"] for name, result in done.items()}
     out = {"recordings": recordings, "mean": mean_over(recordings.values()), "imu_latency_s": lags}
+    if align:
+        out["alignment"] = {name: result["alignment"] for name, result in done.items()}
+    if by:
+        out["by_group"] = by_group(recordings, by)
     failed = {name: result.message for name, result in zip(names, results) if isinstance(result, Failure)}
     if failed:
         out["failed"] = failed

@@ -5,6 +5,7 @@ them, so a second set of files can score it (score_on)."""
 from __future__ import annotations
 
 import csv
+import io
 import itertools
 import math
 import sys
@@ -22,6 +23,7 @@ from attitude_fmu.systems.evaluation.evaluate import (
     method_label,
     recording_names,
 )
+from attitude_fmu.systems.recordings.output import replaced
 from attitude_fmu.systems.recordings.recording import print_notes
 
 BY = {"inclination": "inclination_rmse_deg", "heading": "heading_rmse_deg", "total": "total_rmse_deg"}
@@ -171,15 +173,18 @@ def format_table(result: dict, method: str) -> str:
 
 def write_csv(result: dict, path) -> None:
     """The sweep as CSV: the grid's names, recording, then METRICS (degrees); one row per
-    combination and recording, and a "mean" row after each combination's recordings."""
+    combination and recording, and a "mean" row after each combination's recordings; written
+    as every output is (systems.recordings.output.replaced)."""
     names = [g["name"] for g in result["grid"]]
-    with open(path, "w", newline="", encoding="utf-8") as fh:
-        out = csv.writer(fh)
-        out.writerow([*names, "recording", *METRICS])
-        for r in result["results"]:
-            for recording, errors in [*r["recordings"].items(), ("mean", r["mean"])]:
-                out.writerow([*(repr(r["params"][n]) for n in names), recording,
-                              *(repr(errors.get(m, math.nan)) for m in METRICS)])
+    text = io.StringIO(newline="")
+    out = csv.writer(text)
+    out.writerow([*names, "recording", *METRICS])
+    for r in result["results"]:
+        for recording, errors in [*r["recordings"].items(), ("mean", r["mean"])]:
+            out.writerow([*(repr(r["params"][n]) for n in names), recording,
+                          *(repr(errors.get(m, math.nan)) for m in METRICS)])
+    with replaced(path) as fh:
+        fh.write(text.getvalue().encode("utf-8"))
 
 
 def report(result: dict, method: str, score_on) -> None:

@@ -25,6 +25,13 @@ SATURATION_LEAST = {"gyr": 2.0, "acc": 15.0}  # rad/s, m/s²: below every MEMS r
 SPIKES = (3, 0.001)  # at most this many samples beyond a sensor's range, or this share of them, are spikes
 NO_GRAVITY_M_S2 = 1.0  # an accelerometer norm below this shows no gravity (at rest one reads 9.81 m/s²)
 RANGES = "gyro ±4000 °/s, accelerometer ±400 g per axis"  # MAX_GYR_RAD_S, MAX_ACC_M_S2 as the notes say them
+PILE_BAND = 0.005  # samples within this share of an axis's extreme value are "at" it
+PILE_INSIDE = 10  # ... compared with this many bands of that width just inside it (5 % of the extreme)
+PILE_RATIO = 4.0  # a pile-up: the extreme band holds this many times the samples of those (a smooth peak: 0.43)
+PILE_LEAST = (10, 0.001)  # ... and at least this many samples and this share of them
+RANGE_MATCH = 0.1  # a pile-up within this share of a usual full-scale range is named with it
+ACC_RANGES_G = (2, 4, 6, 8, 12, 16, 24, 32, 64, 100, 200, 400)  # usual accelerometer ranges, ±g
+GYR_RANGES_DEG_S = (125, 250, 300, 500, 1000, 2000, 4000)  # usual gyro ranges, ±°/s
 
 
 def field_norm_note(rec: Recording) -> str | None:
@@ -133,14 +140,14 @@ def typical_peak(values) -> float:
     return float(np.partition(v, len(v) - k - 1)[len(v) - k - 1])
 
 
-def saturation_notes(rec: Recording) -> list[str]:
-    """A note per sensor with an axis held at exactly its largest magnitude (at least
+def saturation_notes(rec: Recording) -> dict:
+    """{gyr or acc: its note} per sensor with an axis held at exactly its largest magnitude (at least
     SATURATION_LEAST) for SATURATION_S or longer: its range, beyond which it misses the
     motion. A smooth peak within the range holds one value for a few ms at most, however
     fine the sampling. An axis that repeats its values half the time elsewhere (a
     noise-free simulation: exact zeros at rest, a turntable's constant rate throughout) is
     not taken for a clipped one."""
-    notes = []
+    notes = {}
     for name, what, unit in (("gyr", "gyro", "rad/s"), ("acc", "accelerometer", "m/s²")):
         clipped = []
         for axis, column in zip("xyz", np.abs(getattr(rec, name)).T):
@@ -154,9 +161,83 @@ def saturation_notes(rec: Recording) -> list[str]:
                 clipped.append(f"{axis} at ±{peak:.4g} {unit} for up to {1e3 * longest / rec.fs:.0f} ms "
                                f"({int(held.sum())} samples)")
         if clipped:
-            notes.append(f"{rec.name}: the {what} stays at its largest value on {'; '.join(clipped)}: its range? "
-                         "Where it saturates the estimate misses the motion beyond it; record with a wider range")
+            notes[name] = (f"{rec.name}: the {what} stays at its largest value on {'; '.join(clipped)}: its range? "
+                           "Where it saturates the estimate misses the motion beyond it; record with a wider range")
     return notes
+
+
+def pile_up_notes(rec: Recording, skip=()) -> list[str]:
+    """A note per sensor (gyr, acc; not those in skip) with an axis piling up at an extreme:
+    the samples within PILE_BAND of its largest value of one sign (at least
+    SATURATION_LEAST) are at least PILE_LEAST and PILE_RATIO times those in the
+    PILE_INSIDE bands of that width just inside it. A smooth peak, however often reached
+    and however coarsely sampled, puts fewer there than inside (a sine's arcsine density:
+    0.43 times as many); a sensor clipped at its range puts every sample beyond it there,
+    exactly or spread by its calibration. Each is named with its value, its share of the
+    samples and the usual range (ACC_RANGES_G, GYR_RANGES_DEG_S) within RANGE_MATCH of it.
+    An axis that repeats its values half the time elsewhere (a noise-free simulation) is
+    not taken for a clipped one."""
+    notes = []
+    for name, what in (("gyr", "gyro"), ("acc", "accelerometer")):
+        if name in skip:
+            continue
+        piled = []
+        for axis, column in zip("xyz", getattr(rec, name).T):
+            for sign in (1.0, -1.0):
+                v = sign * column[np.isfinite(column)]
+                peak = float(v.max()) if len(v) else 0.0
+                if peak < SATURATION_LEAST[name]:
+                    continue
+                at = v >= peak * (1 - PILE_BAND)
+                inside = np.count_nonzero((v >= peak * (1 - (1 + PILE_INSIDE) * PILE_BAND)) & ~at)
+                others = v[~at]
+                repeats = np.mean(others[1:] == others[:-1]) if len(others) > 1 else 1.0
+                least = max(PILE_LEAST[0], PILE_LEAST[1] * len(v))
+                if at.sum() >= max(least, PILE_RATIO * inside) and repeats < 0.5:
+                    piled.append(f"{axis} at {sign * peak:+.4g} {'rad/s' if name == 'gyr' else 'm/s²'} "
+                                 f"({_usual_range(name, peak)}): {int(at.sum())} samples, {at.mean():.1%} of them, "
+                                 f"within {PILE_BAND:.1%} of it against {inside} in the "
+                                 f"{PILE_INSIDE * PILE_BAND:.0%} below")
+        if piled:
+            notes.append(f"{rec.name}: the {what} piles up at its extremes, clipped at its range: {'; '.join(piled)}. "
+                         "Where it clips the estimate misses the motion beyond it; record with a wider range")
+    return notes
+
+
+def _usual_range(name: str, peak: float) -> str:
+    """"1.98 g; likely the ±2 g range": peak (rad/s or m/s²) in °/s or g, with the usual
+    range of the sensor within RANGE_MATCH of it."""
+    if name == "gyr":
+        value, ranges, unit = math.degrees(peak), GYR_RANGES_DEG_S, "°/s"
+    else:
+        value, ranges, unit = peak / G_N, ACC_RANGES_G, "g"
+    near = min(ranges, key=lambda r: abs(value / r - 1))
+    likely = f"; likely the ±{near:g} {unit} range" if abs(value / near - 1) <= RANGE_MATCH else ""
+    return f"{value:.4g} {unit}{likely}"
+
+
+def mark_held(rec: Recording) -> None:
+    """Magnetometer rows that repeat the previous sample exactly (all three axes), where new
+    values come every two rows or more in the median (a magnetometer slower than the gyro,
+    its last sample held by the logger), set to no sample (NaN, the estimators' convention),
+    in place, and noted with the magnetometer's apparent rate. A magnetometer whose values
+    change from one row to the next in the median (repeats at rest, or some rows
+    interpolated) is read as it is."""
+    if rec.mag is None:
+        return
+    rows = np.flatnonzero(np.isfinite(rec.mag).all(axis=1))
+    if len(rows) < 3:
+        return
+    same = (rec.mag[rows[1:]] == rec.mag[rows[:-1]]).all(axis=1)
+    new = np.concatenate([rows[:1], rows[1:][~same]])
+    if len(new) < 2 or np.median(np.diff(new)) < 2:
+        return
+    held = rows[1:][same]
+    rec.mag[held] = np.nan
+    rate = rec.fs * (len(new) - 1) / (new[-1] - new[0])
+    rec.notes.append(f"{rec.name}: the magnetometer repeats its previous sample in {len(held)} of {len(rows)} rows: "
+                     f"held between updates at about {rate:.3g} Hz (a new value every {np.median(np.diff(new)):g} "
+                     "rows in the median); the repeats are taken as no sample (NaN)")
 
 
 def check_values(rec: Recording, gyr_unit: str, acc_unit: str) -> None:

@@ -20,8 +20,11 @@ from attitude_fmu.systems.recordings.checks import (
     check_values,
     fill_invalid,
     hold_until_gravity,
+    mark_held,
+    pile_up_notes,
     saturation_notes,
 )
+from attitude_fmu.systems.recordings.header import check_units, numbered, positions, without_units, written_units
 from attitude_fmu.systems.recordings.recording import (
     ACC_UNITS,
     GYR_UNITS,
@@ -37,29 +40,36 @@ from attitude_fmu.systems.recordings.recording import (
     Recording,
     RecordingError,
 )
+from attitude_fmu.systems.recordings.stamps import timing
 from attitude_fmu.systems.recordings.tables import Source, csv_numbers, decimal_points, parquet_header, parquet_numbers
 
 DELIMITERS = (",", ";", "\t")  # the header's most frequent one; with ";" or a tab, "," is a decimal comma
 MAX_GAP_S = 1.0  # longest run of missing samples filled in by default (s)
 MAX_LABEL_ROWS = 3  # rows without a number after the header that are skipped (units); more: refused
-JITTER_NOTE = 0.1  # time stamps off the uniform grid by more than this share of a step are noted
+DEFAULT_UNITS = {"gyr": "rad/s", "acc": "m/s2", "mag": "uT", "t": "s"}  # a unit flag not given
 
 
-def read_recording(path, fs: float | None = None, gyr_unit: str = "rad/s", acc_unit: str = "m/s2",
-                   mag_unit: str = "uT", max_gap: float = MAX_GAP_S, t_unit: str = "s",
+def read_recording(path, fs: float | None = None, gyr_unit: str | None = None, acc_unit: str | None = None,
+                   mag_unit: str | None = None, max_gap: float = MAX_GAP_S, t_unit: str | None = None,
                    columns: Mapping[str, str] | None = None, gyr_axes: str | None = None,
                    acc_axes: str | None = None, mag_axes: str | None = None) -> Recording:
     """Read a CSV (header `t,gyr_x..z,acc_x..z[,mag_x..z][,ref_q_w..z][,movement]`; t may be
     replaced by fs) or a BROAD .mat, in the units given (GYR_UNITS, ACC_UNITS, MAG_UNITS,
-    T_UNITS), into rad/s, m/s², µT and s (values no IMU gives: check_values). columns
-    ({our name: the CSV's}) reads a header
-    with other names (a logger's export) without editing the file. gyr_axes, acc_axes,
+    T_UNITS; None: not given, DEFAULT_UNITS, and a unit the CSV's header writes that differs
+    is refused, systems.recordings.header.check_units), into rad/s, m/s², µT and s (values no
+    IMU gives: check_values). columns ({our name: the CSV's, or "#N" its N-th column from 1})
+    reads a header with other names (a logger's export) without editing the file. fs
+    overrides a CSV's time stamps (systems.recordings.stamps). A magnetometer held between
+    its updates is read as no sample on the rows that repeat (mark_held). gyr_axes, acc_axes,
     mag_axes: signed axis maps into the output's frame (systems.recordings.axes.parse_axes); an
     accelerometer or magnetometer that does not turn as the gyro says is noted
     (systems.recordings.axes.axes_notes). A CSV's time stamps may jitter and skip samples:
     runs of missing samples up to max_gap seconds are filled in (_fill_gaps), longer ones
     refused; so are runs of gyro or accelerometer values that are not finite
     (fill_invalid), and samples beyond every IMU's range."""
+    given = {"gyr": gyr_unit, "acc": acc_unit, "mag": mag_unit, "t": t_unit}
+    used = {kind: (unit or DEFAULT_UNITS[kind], unit is not None) for kind, unit in given.items()}
+    gyr_unit, acc_unit, mag_unit, t_unit = (used[kind][0] for kind in ("gyr", "acc", "mag", "t"))
     units = ((gyr_unit, GYR_UNITS), (acc_unit, ACC_UNITS), (mag_unit, MAG_UNITS), (t_unit, T_UNITS))
     if any(unit not in known for unit, known in units):
         raise RecordingError(f"units must be one of {', '.join(str(list(known)) for _, known in units)}")
@@ -82,16 +92,20 @@ def read_recording(path, fs: float | None = None, gyr_unit: str = "rad/s", acc_u
     if shared:
         raise RecordingError(f"--column gives the file's column {', '.join(shared)} more than one name")
     if mat:
+        numbered_ = [c for c in columns.values() if c.startswith("#")]
+        if numbered_:
+            raise RecordingError(f"--column {', '.join(numbered_)}: a .mat's variables are named, not numbered")
         rec = _read_mat(source, fs, columns)
     else:
         try:
-            rec = _read_table(source, fs, max_gap, T_UNITS[t_unit], columns)
+            rec = _read_table(source, fs, max_gap, used, columns)
         except UnicodeDecodeError as exc:
             raise source.not_text(exc) from None
     if fs is not None and abs(rec.fs - fs) > 0.01 * fs:
         raise RecordingError(f"{source.label}: --fs {fs:g} Hz disagrees with the recording's {rec.fs:g} Hz")
     rec.gyr *= GYR_UNITS[gyr_unit]  # in place: the recording's arrays are its own
     rec.acc *= ACC_UNITS[acc_unit]
+    mark_held(rec)
     if rec.mag is not None and np.isnan(rec.mag).any(axis=1).all():
         rec.mag = None
         rec.notes.append(f"{rec.name}: the magnetometer has no sample (NaN throughout); heading from the gyro")
@@ -102,7 +116,8 @@ def read_recording(path, fs: float | None = None, gyr_unit: str = "rad/s", acc_u
     check_values(rec, gyr_unit, acc_unit)
     fill_invalid(rec, max_gap)
     hold_until_gravity(rec)
-    rec.notes += saturation_notes(rec)
+    clipped = saturation_notes(rec)
+    rec.notes += [*clipped.values(), *pile_up_notes(rec, skip=clipped)]
     for name, matrix in maps.items():
         if getattr(rec, name) is not None:
             setattr(rec, name, getattr(rec, name) @ matrix.T)
@@ -110,11 +125,13 @@ def read_recording(path, fs: float | None = None, gyr_unit: str = "rad/s", acc_u
     return rec
 
 
-def _read_table(source: Source, fs: float | None, max_gap: float, t_scale: float, columns: dict) -> Recording:
+def _read_table(source: Source, fs: float | None, max_gap: float, used: dict, columns: dict) -> Recording:
     """A CSV or (by its suffix) a Parquet file: header t,gyr_x..z,acc_x..z and the optional
-    columns, checked before the numbers are read."""
+    columns, checked before the numbers are read, with the units the header writes against
+    those used ({quantity: (unit, given?)}); its time stamps read as systems.recordings.stamps
+    says."""
     path, parquet = source.label, source.suffix == PARQUET_SUFFIX
-    labels = []
+    labels, delimiter = [], ","
     if parquet:
         header = parquet_header(source)
     else:
@@ -128,54 +145,65 @@ def _read_table(source: Source, fs: float | None, max_gap: float, t_scale: float
         header = [h.strip() for h in header]
         header[0] = header[0].lstrip("#").strip()  # a header marked as a comment (numpy.savetxt's default)
         labels = _label_rows(following, delimiter)
+    original = header
     header = _renamed(path, header, columns)
+    header, with_units = without_units(header, [c for c in KNOWN_COLUMNS if c not in columns])
+    unit_notes = check_units(path, source.path.stem, written_units(header, original, [
+        next(csv.reader([line], delimiter=delimiter)) for line in labels]), used)
     missing = [c for c in IMU_COLUMNS if c not in header]
     if missing:
+        unclear = any(not h or header.count(h) > 1 for h in header)  # select by position
         raise RecordingError(f"{path}: missing columns {', '.join(missing)} (header: {','.join(header)})"
+                             f"{'; name them by position, --column NAME=#N: ' + numbered(header) if unclear else ''}"
                              f"{_column_hint(missing, header)}")
     for group, what in ((MAG_COLUMNS, "the magnetometer"), (REF_COLUMNS, "the reference")):
         given = [c for c in group if c in header]
         if given and len(given) < len(group):
             raise RecordingError(f"{path}: {what} needs all of {','.join(group)}, "
                                  f"the header has only {','.join(given)}")
-    if "t" not in header and fs is None:
+    if "t" not in header and fs is None:  # after the units: "t (ms)" says --t-unit
         raise RecordingError(f"{path}: no 't' column; give the sample rate with --fs HZ{_column_hint(['t'], header)}")
+    wanted = [k for k, name in enumerate(header) if name in KNOWN_COLUMNS]  # the others are not read
     if parquet:
-        data = parquet_numbers(source, header)
+        data = parquet_numbers(source, header, wanted, flags=(MOVEMENT_COLUMN,))
     else:
         skip = 1 + len(labels)
-        data = csv_numbers(source, delimiter, len(header), skip,
-                           lambda: _first_bad_line(source, delimiter, header, skip))
+        data = csv_numbers(source, delimiter, len(header), skip, wanted,
+                           lambda: _first_bad_line(source, delimiter, header, skip, wanted))
     if len(data) == 0:
         raise RecordingError(f"{path}: expected {len(header)} columns of numbers and at least one row")
     index = {name: i for i, name in enumerate(header)}
     stack = lambda names: data.stack([index[c] for c in names]) if all(c in index for c in names) else None
     movement = data.column(index[MOVEMENT_COLUMN]) if MOVEMENT_COLUMN in index else None
     rec = Recording(source.path.stem, 0.0, stack(IMU_COLUMNS[:3]), stack(IMU_COLUMNS[3:]),
-                    None if "t" not in index else data.column(index["t"]) * t_scale,
+                    None if "t" not in index else data.column(index["t"]) * T_UNITS[used["t"][0]],
                     stack(MAG_COLUMNS), stack(REF_COLUMNS),
                     None if movement is None else _flag(path, MOVEMENT_COLUMN, movement))
     del data
+    rec.notes += unit_notes
+    if with_units:
+        rec.notes.append(f"{rec.name}: read {', '.join(f'{original[k]!r} as {header[k]}' for k in with_units)}")
     if labels:
         rec.notes.append(f"{rec.name}: {len(labels)} row{'s' * (len(labels) > 1)} after the header without a number "
                          f"skipped (units?): {' / '.join(labels)}")
     unknown = [c for c in header if c not in KNOWN_COLUMNS]
     if unknown:
         absent = [c for c in KNOWN_COLUMNS if c not in header]
-        rec.notes.append(f"{rec.name}: columns not read: {', '.join(unknown)}{_column_hint(absent, unknown)}")
+        rec.notes.append(f"{rec.name}: columns not read: {', '.join(c or '(unnamed)' for c in unknown)}"
+                         f"{_column_hint(absent, unknown)}")
     if rec.t is None:
         rec.fs, rec.t = float(fs), np.arange(1, len(rec.gyr) + 1) / fs
         return rec
     if not np.isfinite(rec.t).all():
         raise RecordingError(f"{path}: column t has non-finite values")
-    if len(rec.t) == 1 and fs is not None:  # one time stamp gives no rate; --fs does
+    if len(rec.t) == 1:  # one time stamp gives no rate; --fs does
+        if fs is None:
+            raise RecordingError(f"{path}: one sample cannot give a sample rate; give --fs HZ")
         rec.fs = float(fs)
         return rec
-    index, rec.fs, off_grid = _sample_grid(path, rec.t, max_gap)
-    if off_grid > JITTER_NOTE:
-        rec.notes.append(f"{rec.name}: time stamps up to {off_grid:.0%} of a step off a uniform grid; "
-                         f"the samples are taken as uniform at {rec.fs:.6g} Hz")
-    if index[-1] + 1 > len(index):
+    index, rec.fs, notes = timing(path, rec.name, rec.t, fs, max_gap)
+    rec.notes += notes
+    if index is not None and index[-1] + 1 > len(index):
         rec = _fill_gaps(rec, index)
     return rec
 
@@ -186,27 +214,28 @@ def _label_rows(lines, delimiter: str) -> list[str]:
     loggers write them."""
     labels = []
     for line in lines:
-        fields = decimal_points(line, delimiter).strip().split(delimiter)
+        fields = next(csv.reader([decimal_points(line, delimiter).strip()], delimiter=delimiter), [])
         if not line.strip() or any(_is_number(f) for f in fields):
             break
         labels.append(line.strip())
     return labels if len(labels) <= MAX_LABEL_ROWS else []
 
 
-def _first_bad_line(source: Source, delimiter: str, header: list[str], skip: int) -> str:
-    """Where the rows after the first `skip` lines stop being numbers under the header, said
-    with the file's line number and the column's name."""
-    with source.text() as fh:
-        for number, line in enumerate(fh, start=1):
-            text = line.strip()
-            if number <= skip or not text or text.startswith("#"):
+def _first_bad_line(source: Source, delimiter: str, header: list[str], skip: int, wanted) -> str:
+    """Where the rows after the first `skip` lines stop being numbers in the columns wanted
+    (positions in header) or have another number of fields (quoted as the csv module reads
+    them), said with the file's line number and the column's name."""
+    with source.text(newline="") as fh:
+        rows = csv.reader(fh, delimiter=delimiter)
+        for fields in rows:
+            number, text = rows.line_num, delimiter.join(fields)
+            if number <= skip or not text.strip() or text.lstrip().startswith("#"):
                 continue
-            fields = decimal_points(text, delimiter).split(delimiter)
             if len(fields) != len(header):
                 return f"line {number} has {len(fields)} fields, the header {len(header)}: {text[:80]!r}"
-            for name, field in zip(header, fields):
-                if not _is_number(field):
-                    return f"unreadable number in line {number}, column {name}: {field.strip()[:40]!r}"
+            for k in wanted:
+                if not _is_number(decimal_points(fields[k], delimiter)):
+                    return f"unreadable number in line {number}, column {header[k]}: {fields[k].strip()[:40]!r}"
     return "unreadable numbers"
 
 
@@ -219,14 +248,12 @@ def _is_number(text: str) -> bool:
 
 
 def _renamed(path, header: list[str], columns: dict) -> list[str]:
-    """header with the names columns maps ({ours: the file's}) replaced by ours; a column
-    of the file that has one of those names already is left unread. Names read twice are
-    refused."""
-    absent = [theirs for theirs in columns.values() if theirs not in header]
-    if absent:
-        raise RecordingError(f"{path}: --column names {', '.join(absent)}, not in the header ({','.join(header)})")
-    ours = {theirs: name for name, theirs in columns.items()}
-    header = [ours.get(h, f"{h} (replaced by --column)" if h in columns else h) for h in header]
+    """header with the columns that columns maps ({ours: the file's name or "#N"}) named
+    ours; a column of the file that has one of those names already is left unread. Names
+    read twice are refused."""
+    placed = positions(path, header, columns)
+    ours = {k: name for name, k in placed.items()}
+    header = [ours.get(k, f"{h} (replaced by --column)" if h in columns else h) for k, h in enumerate(header)]
     twice = sorted({h for h in header if h in KNOWN_COLUMNS and header.count(h) > 1})
     if twice:
         raise RecordingError(f"{path}: the header has {', '.join(twice)} more than once")
@@ -240,39 +267,6 @@ def _column_hint(wanted, header) -> str:
     found = {key(h): h for h in header}
     flags = [f"--column {shlex.quote(f'{c}={found[key(c)]}')}" for c in wanted if key(c) in found]
     return f"; to read them pass {' '.join(flags)}" if flags else ""
-
-
-def _sample_grid(path, t: np.ndarray, max_gap: float) -> tuple[np.ndarray, float, float]:
-    """(index of each row on a uniform grid, its rate in Hz, largest distance of a time
-    stamp from the grid in steps). Each time step counts as the whole number of median
-    steps nearest to it, so jitter below half a step is tolerated and a longer step is a
-    run of missing samples; the rate comes from the whole span, so rounded time stamps
-    do not bias it."""
-    if len(t) < 2:
-        raise RecordingError(f"{path}: one sample cannot give a sample rate; give --fs HZ")
-    dt = np.diff(t)
-    if np.any(dt <= 0):
-        r = int(np.argmax(dt <= 0))
-        raise RecordingError(f"{path}: column t must increase strictly (row {r + 2}: {t[r + 1]:g} s after {t[r]:g} s)")
-    step = float(np.median(dt))
-    count = np.rint(dt / step)
-    if np.any(count < 1):
-        r = int(np.argmax(count < 1))
-        raise RecordingError(f"{path}: column t is irregular: the step to row {r + 2} is {dt[r]:g} s, "
-                             f"less than half the usual {step:g} s")
-    index = np.concatenate([[0], np.cumsum(count)]).astype(np.int64)
-    fs = float(index[-1] / (t[-1] - t[0]))
-    check_rate(path, fs)  # before the gaps, which a wrong time unit makes look long
-    off_grid = float(np.max(np.abs(t - t[0] - index / fs)) * fs)
-    if off_grid > 0.5:
-        raise RecordingError(f"{path}: column t is irregular: time stamps up to {off_grid:.1f} steps off "
-                             f"a uniform grid at {fs:.6g} Hz (does the sample rate change?)")
-    r = int(np.argmax(count))
-    if (count[r] - 1) / fs > max_gap:
-        raise RecordingError(f"{path}: {int(count[r]) - 1} samples missing after row {r + 1} (t = {t[r]:g} s), "
-                             f"a gap of {(count[r] - 1) / fs:g} s, longer than --max-gap {max_gap:g} s; "
-                             "split the recording there or raise --max-gap")
-    return index, fs, off_grid
 
 
 def _fill_gaps(rec: Recording, index: np.ndarray) -> Recording:
@@ -316,19 +310,26 @@ def _flag(path, name: str, values) -> np.ndarray:
 
 def _read_mat(source: Source, fs: float | None, columns: dict) -> Recording:
     """A BROAD recording, its variables (MAT_VARIABLES) renamed from the file's by columns
-    ({BROAD's name: the file's}); without a sampling_rate variable, at fs (Hz) if given."""
-    from scipy.io import loadmat
+    ({BROAD's name: the file's}); without a sampling_rate variable, at fs (Hz) if given. The
+    file's other variables are listed, not read; logical ones are read as booleans."""
+    from scipy.io import loadmat, whosmat
 
     path = source.label
     file = source.path if source.data is None else io.BytesIO(source.data)
+    read = [columns.get(name, name) for name in MAT_VARIABLES]
     try:
-        mat = loadmat(file, squeeze_me=True)
+        listed = {name: kind for name, _, kind in whosmat(file)}  # each variable's class, its data unread
+        if source.data is not None:
+            file.seek(0)
+        mat = loadmat(file, squeeze_me=True, variable_names=[name for name in read if name in listed])
+        mat = {name: np.asarray(value, dtype=bool) if listed[name] == "logical" else value
+               for name, value in mat.items() if not name.startswith("__")}
     except NotImplementedError:  # scipy's answer to a v7.3 file
-        mat = _read_mat_v73(path, file)
+        listed, mat = _read_mat_v73(path, file, read)
     except Exception as exc:  # scipy raises several types for damaged files
         raise RecordingError(f"{path}: not a readable MATLAB file ({exc})") from None
-    variables = ", ".join(k for k in mat if not k.startswith("__")) or "none"
-    absent = [theirs for theirs in columns.values() if theirs not in mat]
+    variables = ", ".join(listed) or "none"
+    absent = [theirs for theirs in columns.values() if theirs not in listed]
     if absent:
         raise RecordingError(f"{path}: --column names {', '.join(absent)}, not a variable of the file ({variables})")
     mat = {**{k: v for k, v in mat.items() if k not in columns},
@@ -338,10 +339,11 @@ def _read_mat(source: Source, fs: float | None, columns: dict) -> Recording:
         raise RecordingError(f"{path}: missing variables {', '.join(missing)} (expected a BROAD recording"
                              f"{'; without sampling_rate give --fs HZ' if 'sampling_rate' in missing else ''}; "
                              f"the file has {variables}: name them with --column, e.g. --column imu_gyr=NAME)")
-    try:
-        fs = float(mat["sampling_rate"]) if "sampling_rate" in mat else fs
-    except (TypeError, ValueError):
-        raise RecordingError(f"{path}: sampling_rate must be one number (Hz)") from None
+    if "sampling_rate" in mat:
+        rate = _numbers(path, mat, "sampling_rate")
+        if rate.size != 1:
+            raise RecordingError(f"{path}: sampling_rate must be one number (Hz), it has {rate.size}")
+        fs = float(rate.reshape(()))
     check_rate(path, fs)
     gyr, acc = (np.atleast_2d(_numbers(path, mat, key)) for key in ("imu_gyr", "imu_acc"))
     n = len(gyr)
@@ -366,22 +368,41 @@ def _read_mat(source: Source, fs: float | None, columns: dict) -> Recording:
 
 
 def _numbers(path: str, mat: dict, key: str) -> np.ndarray:
-    """The variable key of a MATLAB file as an array of floats, or an error saying what it holds."""
+    """The variable key of a MATLAB file as an array of floats, or an error saying what it
+    holds: complex numbers (their imaginary part would be lost) and logical values are
+    refused, but for the movement flag, which may be logical."""
+    value = np.asarray(mat[key])
+    kind = value.dtype.kind
+    if kind == "c" or kind == "b" and key != MOVEMENT_COLUMN:
+        raise RecordingError(f"{path}: {key} holds {'complex numbers' if kind == 'c' else 'logical values'}, "
+                             "expected real numbers")
     try:
-        return np.asarray(mat[key], dtype=float)
+        return np.asarray(value, dtype=float)
     except (TypeError, ValueError):
         raise RecordingError(f"{path}: {key} holds {type(mat[key]).__name__} "
                              f"{getattr(mat[key], 'dtype', '')}, expected a numeric array") from None
 
 
-def _read_mat_v73(path: str, file) -> dict:
-    """The numeric variables of a MATLAB v7.3 file (HDF5) at file, as loadmat(squeeze_me=True)
-    gives them from older versions: HDF5 holds MATLAB's arrays transposed."""
+def _read_mat_v73(path: str, file, read) -> tuple[list[str], dict]:
+    """(the names of the variables, those of read as loadmat(squeeze_me=True) gives them
+    from older versions) of a MATLAB v7.3 file (HDF5) at file: HDF5 holds MATLAB's arrays
+    transposed, complex ones as pairs (real, imag), logical ones as uint8 marked so."""
     import h5py
 
     try:
         with h5py.File(file, "r") as f:
-            return {name: np.squeeze(np.asarray(item).T) for name, item in f.items()
-                    if isinstance(item, h5py.Dataset) and item.dtype.kind in "fiub"}
+            listed = [name for name in f if not name.startswith("#")]  # "#refs#": MATLAB's own
+            mat = {name: _v73_array(f[name]) for name in read if name in f and isinstance(f[name], h5py.Dataset)}
     except OSError as exc:
         raise RecordingError(f"{path}: not a readable MATLAB v7.3 file ({exc})") from None
+    return listed, mat
+
+
+def _v73_array(item) -> np.ndarray:
+    """A v7.3 dataset as the array MATLAB holds (see _read_mat_v73)."""
+    value = np.asarray(item)
+    if value.dtype.names == ("real", "imag"):
+        value = value["real"] + 1j * value["imag"]
+    elif item.attrs.get("MATLAB_class") in (b"logical", "logical"):
+        value = value.astype(bool)
+    return np.squeeze(value.T)

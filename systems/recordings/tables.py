@@ -82,12 +82,16 @@ class Source:
 
 
 class Columns:
-    """Columns of numbers by position, read one at a time (the table they come from is
-    kept once, not copied whole): len() rows; column(i) a float array; stack(indices)
-    the N×k array of those columns."""
+    """Columns of numbers by their position in the file, read one at a time (the table they
+    come from is kept once, not copied whole): len() rows; column(i) a float array;
+    stack(indices) the N×k array of those columns. Only the columns wanted were read:
+    column(k) is read(j) for the j-th of them, k = wanted[j]."""
 
-    def __init__(self, rows: int, column):
-        self.rows, self.column = rows, column
+    def __init__(self, rows: int, read, wanted):
+        self.rows, self._read, self._place = rows, read, {k: j for j, k in enumerate(wanted)}
+
+    def column(self, k: int) -> np.ndarray:
+        return self._read(self._place[k])
 
     def __len__(self) -> int:
         return self.rows
@@ -99,26 +103,31 @@ class Columns:
         return out
 
 
-def csv_numbers(source: Source, delimiter: str, width: int, skip: int, bad_line) -> Columns:
-    """The numbers of a CSV after its first skip lines, width columns separated by
-    delimiter (with ";" or a tab, "," is a decimal comma); lines starting with "#" and
-    empty ones skipped. pyarrow's reader takes them; what it refuses (a comment after the
-    numbers, ...) numpy's loadtxt tries; what neither reads, bad_line() says."""
+def csv_numbers(source: Source, delimiter: str, width: int, skip: int, wanted, bad_line) -> Columns:
+    """The numbers of the columns wanted (positions) of a CSV after its first skip lines,
+    width columns separated by delimiter (with ";" or a tab, "," is a decimal comma), fields
+    quoted as RFC 4180 says (the csv module's dialect: "a,b" one field, "" a quote, line
+    breaks in quotes); lines starting with "#" and empty ones skipped. The other columns are
+    split off but never read as numbers: text, empty fields pass. pyarrow's reader takes them;
+    what it refuses (a comment after the numbers, ...) numpy's loadtxt tries; what neither
+    reads, bad_line() says."""
     import pyarrow as pa
     import pyarrow.csv as pc
 
     names = [f"c{i}" for i in range(width)]
+    read = [names[k] for k in wanted]
     try:
         table = pc.read_csv(
             source.binary(),
             read_options=pc.ReadOptions(skip_rows=skip, column_names=names),
-            parse_options=pc.ParseOptions(delimiter=delimiter, invalid_row_handler=_comment_row),
-            convert_options=pc.ConvertOptions(column_types={n: pa.float64() for n in names}, null_values=[],
-                                              strings_can_be_null=False,
+            parse_options=pc.ParseOptions(delimiter=delimiter, invalid_row_handler=_comment_row,
+                                          newlines_in_values=True),
+            convert_options=pc.ConvertOptions(include_columns=read, column_types={n: pa.float64() for n in read},
+                                              null_values=[], strings_can_be_null=False,
                                               decimal_point="." if delimiter == "," else ","))
     except (pa.ArrowInvalid, pa.ArrowNotImplementedError):
-        return _loadtxt(source, delimiter, width, skip, bad_line)
-    return Columns(table.num_rows, lambda i: floats(table.column(i)))
+        return _loadtxt(source, delimiter, width, skip, wanted, bad_line)
+    return Columns(table.num_rows, lambda j: floats(table.column(j)), wanted)
 
 
 def floats(column) -> np.ndarray:
@@ -140,18 +149,17 @@ def _comment_row(row) -> str:
     return "skip" if row.text is not None and row.text.lstrip().startswith("#") else "error"
 
 
-def _loadtxt(source: Source, delimiter: str, width: int, skip: int, bad_line) -> Columns:
+def _loadtxt(source: Source, delimiter: str, width: int, skip: int, wanted, bad_line) -> Columns:
     try:
         with warnings.catch_warnings():  # no rows: said by the caller, not as numpy's warning
             warnings.simplefilter("ignore", UserWarning)
             with source.text() as fh:
                 rows = fh if delimiter == "," else (decimal_points(line, delimiter) for line in fh)
-                data = np.loadtxt(rows, delimiter=delimiter, skiprows=skip, ndmin=2, dtype=float)
+                data = np.loadtxt(rows, delimiter=delimiter, skiprows=skip, ndmin=2, dtype=float, usecols=wanted,
+                                  quotechar='"')
     except ValueError:
         raise RecordingError(f"{source.label}: {bad_line()}") from None
-    if data.shape[1] != width and len(data):
-        raise RecordingError(f"{source.label}: expected {width} columns of numbers, got {data.shape[1]}")
-    return Columns(len(data), lambda i: data[:, i])
+    return Columns(len(data), lambda j: data[:, j], wanted)
 
 
 def decimal_points(line: str, delimiter: str) -> str:
@@ -170,17 +178,23 @@ def parquet_header(source: Source) -> list[str]:
                              f"t,{','.join(IMU_COLUMNS)}") from None
 
 
-def parquet_numbers(source: Source, header: list[str]) -> Columns:
-    """A Parquet file's columns (all of header, numbers of any type, read as float64)."""
+def parquet_numbers(source: Source, header: list[str], wanted, flags=()) -> Columns:
+    """The columns wanted (positions) of a Parquet file, numbers of any type read as float64
+    (booleans only in the columns named in flags); header names them in messages. The
+    other columns are not read."""
     import pyarrow as pa
     import pyarrow.parquet as pq
 
     try:
-        table = pq.read_table(source.binary())
+        file = pq.ParquetFile(source.binary())
+        names = file.schema_arrow.names
+        table = file.read(columns=[names[k] for k in wanted])
     except Exception as exc:
         raise RecordingError(f"{source.label}: not a readable Parquet file ({exc})") from None
-    for name, field in zip(header, table.schema):
-        if not (pa.types.is_floating(field.type) or pa.types.is_integer(field.type)
-                or pa.types.is_boolean(field.type)):
-            raise RecordingError(f"{source.label}: column {name} holds {field.type}, expected numbers")
-    return Columns(table.num_rows, lambda i: floats(table.column(i).cast(pa.float64())))
+    for k, field in zip(wanted, table.schema):
+        boolean = pa.types.is_boolean(field.type)
+        if not (pa.types.is_floating(field.type) or pa.types.is_integer(field.type) or boolean) \
+                or boolean and header[k] not in flags:
+            raise RecordingError(f"{source.label}: column {header[k]} holds {field.type}, expected numbers"
+                                 f"{' (booleans only in ' + ', '.join(flags) + ')' if boolean and flags else ''}")
+    return Columns(table.num_rows, lambda j: floats(table.column(j).cast(pa.float64())), wanted)

@@ -11,7 +11,7 @@ from attitude_fmu.systems.recordings.recording import PARQUET_SUFFIX
 
 OUTPUT_COLUMNS = ("t", "q_w", "q_x", "q_y", "q_z", "g_x", "g_y", "g_z")
 EULER_COLUMNS = ("roll_deg", "pitch_deg", "yaw_deg")  # with --euler
-CSV_DIGITS = 10  # significant digits of the CSV's numbers (Parquet keeps every bit)
+CSV_DIGITS = 10  # significant digits of the CSV's estimates (t and Parquet keep every bit)
 ROWS_PER_BATCH = 1 << 16  # rows converted and written at a time: memory stays small whatever the length
 
 
@@ -58,7 +58,8 @@ def write_estimate(path, t, quat, up, euler: bool = False, extra=None) -> None:
     euler adds roll, pitch and yaw in degrees (EULER_COLUMNS, euler_degrees); extra
     ({name: N×3 or N}) adds name_x,name_y,name_z, or the column name, after them. A path
     ending in PARQUET_SUFFIX gets a Parquet file (float64, every bit), any other a CSV
-    (CSV_DIGITS significant digits); "-" the CSV on standard output. Written by
+    (t with the digits that read back to its every bit, up to 17: epoch time stamps keep
+    their steps; the others CSV_DIGITS significant digits); "-" the CSV on standard output. Written by
     systems.recordings.output.replaced: complete, or not at all."""
     import pyarrow as pa
 
@@ -79,7 +80,8 @@ def write_estimate(path, t, quat, up, euler: bool = False, extra=None) -> None:
             for _, values in blocks:
                 values = euler_degrees(quat[rows]) if values is None else values[rows]
                 columns += [np.ascontiguousarray(c, dtype=float) for c in values.T]
-            yield pa.RecordBatch.from_arrays([_arrow(c if parquet else significant(c)) for c in columns], schema=schema)
+            yield pa.RecordBatch.from_arrays([_arrow(c if parquet or j == 0 else significant(c))  # 0: t
+                                              for j, c in enumerate(columns)], schema=schema)
 
     with replaced(path) as fh:
         if parquet:
