@@ -59,7 +59,7 @@ def platform_fmus(host_fmus, tmp_path_factory):
         (folder / f"fmi{fmi}").mkdir(exist_ok=True)
         fmus[name, fmi] = Path(shutil.copyfile(path, folder / f"fmi{fmi}" / path.name))
     builds = add_platforms(fmus.values(), list(PLATFORMS), BUILD_ROOT, OPTIONS, log=lambda m: None,
-                           targets=["fmi_runner"])
+                           targets=["fmi_runner"], source=ROOT)  # the clone: its tests/ hold the runner
     runners = {p: builds[p] / "tests" / ("fmi_runner.exe" if p.endswith("windows") else "fmi_runner")
                for p in RUNNER_PLATFORMS}
     return fmus, runners

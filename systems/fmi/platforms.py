@@ -64,18 +64,20 @@ def default_build_root(source: Path) -> Path:
     return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "attitude_fmu" / "build"
 
 
-def cross_build(platform: str, build_root=None, options=(), targets=()) -> Path:
-    """The FMUs' libraries for one platform (and the targets, e.g. tests/fmi_runner), built by CMake
-    with zig's compiler in build_root/platform-<platform>; returns that folder. Raises
-    subprocess.CalledProcessError where CMake or the compiler fails."""
+def cross_build(platform: str, build_root=None, options=(), targets=(), source=None) -> Path:
+    """The FMUs' libraries for one platform (and the targets, e.g. tests/fmi_runner of a clone), built
+    by CMake with zig's compiler from source (default: the package's folder, or the clone it is) in
+    build_root/platform-<platform>; returns that folder. Raises subprocess.CalledProcessError where
+    CMake or the compiler fails."""
     from attitude_fmu.build_fmu import ROOT, cmake_build, project_version
 
+    source = Path(source or ROOT)
     zig_target, fmi2 = PLATFORMS[platform]
-    folder = Path(build_root or default_build_root(ROOT)) / f"platform-{platform}"
+    folder = Path(build_root or default_build_root(source)) / f"platform-{platform}"
     libraries = [f"{name}_fmi3" for name in NATIVE_NAMES] + ([f"{name}_fmi2" for name in NATIVE_NAMES] if fmi2 else [])
-    configure = (f"CMAKE_TOOLCHAIN_FILE={ROOT / TOOLCHAIN}", f"AF_ZIG_TARGET={zig_target}", "AF_PYTHON=OFF",
+    configure = (f"CMAKE_TOOLCHAIN_FILE={source / TOOLCHAIN}", f"AF_ZIG_TARGET={zig_target}", "AF_PYTHON=OFF",
                  f"AF_VERSION={project_version()}", *options)
-    return cmake_build(folder, [*libraries, *targets], configure, source=ROOT)
+    return cmake_build(folder, [*libraries, *targets], configure, source=source)
 
 
 def binaries(folder: Path, fmi: int, name: str) -> dict[str, Path]:
@@ -108,14 +110,15 @@ def fmi_version(fmu: Path) -> int:
         return int(ElementTree.fromstring(zf.read("modelDescription.xml")).get("fmiVersion").split(".")[0])
 
 
-def add_platforms(fmus, platforms, build_root=None, options=(), log=print, targets=()) -> dict[str, Path]:
+def add_platforms(fmus, platforms, build_root=None, options=(), log=print, targets=(), source=None) -> dict[str, Path]:
     """The binaries of the platforms (FMI 3.0 tuples, parse_platforms) cross-built (cross_build, with
-    the targets; as many platforms at once as there are processors) and put into each native FMU of
-    fmus (paths; named by their model identifier); returns each platform's build folder."""
+    the targets, from source; as many platforms at once as there are processors) and put into each
+    native FMU of fmus (paths; named by their model identifier); returns each platform's build folder."""
     fmus = [Path(fmu) for fmu in fmus]
     log(f"building the native FMUs' binaries for {', '.join(platforms)}")
     with ThreadPoolExecutor(max_workers=max(1, min(len(platforms), os.cpu_count() or 1))) as pool:
-        folders = dict(zip(platforms, pool.map(lambda p: cross_build(p, build_root, options, targets), platforms)))
+        folders = dict(zip(platforms, pool.map(lambda p: cross_build(p, build_root, options, targets, source),
+                                               platforms)))
     for folder in folders.values():
         for fmu in fmus:
             add_binaries(fmu, binaries(folder, fmi_version(fmu), fmu.stem))
