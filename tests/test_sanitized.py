@@ -1,7 +1,8 @@
 """The C core, its Python extension and the native FMUs built with -fsanitize=address,undefined
 (CMake, through tests/native.py), run over the golden streams, the refusals and the simulation
-again: the same results, and no report of an out-of-bounds access, a use of uninitialised
-memory or undefined behaviour."""
+again, and through the FMU-state, count and step refusals of tests/test_fmu_state.py: the same
+results, and no report of an out-of-bounds access, a use of freed or uninitialised memory or
+undefined behaviour."""
 import pytest
 
 from tests import native
@@ -12,11 +13,20 @@ pytestmark = [pytest.mark.slow,
               pytest.mark.skipif(native.sanitized_build() is not None, reason="this is the sanitized run")]
 
 
-def test_the_golden_streams_refusals_and_simulation_run_clean_on_the_sanitized_build():
-    run = native.sanitized_pytest("tests/test_golden.py", "tests/test_refusals.py", "tests/test_simulation.py",
-                                  "tests/test_quaternion.py", timeout=3600)
+def assert_clean(*test_files):
+    """pytest on the test files in the sanitized run: every test passed, no sanitizer's report."""
+    run = native.sanitized_pytest(*test_files, timeout=3600)
     if run is None:
         pytest.skip("the C compiler names no address-sanitizer runtime")
     assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
     assert not [r for r in REPORTS if r in run.stderr], run.stderr[-3000:]
     assert " passed" in run.stdout and " failed" not in run.stdout and " skipped" not in run.stdout
+
+
+def test_the_golden_streams_refusals_and_simulation_run_clean_on_the_sanitized_build():
+    assert_clean("tests/test_golden.py", "tests/test_refusals.py", "tests/test_simulation.py",
+                 "tests/test_quaternion.py")
+
+
+def test_the_fmu_state_refusals_run_clean_on_the_sanitized_build():
+    assert_clean("tests/test_fmu_state.py")

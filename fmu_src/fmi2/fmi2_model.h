@@ -7,8 +7,9 @@
  * variable's causality and variability forbid: fmi2Error with a log message), saves and
  * serialises FMU states, and logs through the importer's callback. A model file (models/<Name>.c)
  * defines `fmi2_model`: its variables (a table generated from the project's table of FMU
- * variables, fmu_src/variables.py, into <Name>_variables.h), the size of its own state and two
- * functions, called at fmi2ExitInitializationMode and at each fmi2DoStep. */
+ * variables, fmu_src/variables.py, into <Name>_variables.h), the size of its own state and three
+ * functions: called at fmi2ExitInitializationMode, at each fmi2DoStep, and on an FMU state before
+ * fmi2SetFMUstate or fmi2DeSerializeFMUstate takes it (fmi2/fmu_state.h). */
 #ifndef FMI2_MODEL_H
 #define FMI2_MODEL_H
 
@@ -55,8 +56,15 @@ typedef struct {
     /* fmi2ExitInitializationMode: build the model from its parameters. fmi2OK, fmi2Warning, or
      * fmi2Error with a logged message (an invalid parameter). */
     fmi2Status (*initialise)(Fmi2Instance *instance);
-    /* fmi2DoStep from t over h seconds (h > 0, finite): inputs read, outputs written. */
+    /* fmi2DoStep from t over h seconds (t and h finite, h > 0): inputs read, outputs written; fmi2Error
+     * with the model's state and outputs as they were where its arithmetic cannot take the step (its end
+     * t + h not finite, an overflow). */
     fmi2Status (*step)(Fmi2Instance *instance, fmi2Real t, fmi2Real h);
+    /* An initialised model's state from an FMU state (state_size bytes nobody vouches for), checked
+     * against configured: the state initialise makes from the same FMU state's parameters. 0 where
+     * every field is in its range and whatever is derived from the parameters is configured's, else
+     * -1 with the reason in message (size bytes). It reads the bytes only. */
+    int (*validate)(const void *state, const void *configured, char *message, size_t size);
 } Fmi2Model;
 
 extern const Fmi2Model fmi2_model; /* defined by the model file */
@@ -79,6 +87,10 @@ struct Fmi2Instance {
     int debug;                /* debug logging on */
     unsigned long categories; /* bit k: category k of log_categories on */
     fmi2Status logged;        /* the most severe status logged during the current call */
+    fmi2Real time;            /* FMI 3.0's independent variable `time` (s): the start time, then the end of
+                                 each step taken; held in FMU states */
+    void **states;            /* the FMU states this instance made and has not freed (fmi2/fmu_state.h) */
+    size_t n_states, states_capacity;
 };
 
 /* Log a message (printf format) with the status's category (logStatusWarning, logStatusError, ...):

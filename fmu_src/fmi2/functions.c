@@ -2,7 +2,6 @@
  * instance's state allows the call (instance.h: fmi2_enter), does it, and returns the status the
  * standard gives it, raised to what the call logged (fmi2_leave). A call without an instance
  * (NULL) returns fmi2Error: there is no logger to tell. */
-#include <math.h>
 #include <string.h>
 
 #include "fmi2_model.h"
@@ -47,7 +46,7 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     return fmi2_instance_new(instanceName, functions, loggingOn);
 }
 
-void fmi2FreeInstance(fmi2Component c) {
+void fmi2FreeInstance(fmi2Component c) { /* with the FMU states it still holds */
     if (c) fmi2_instance_free((Fmi2Instance *)c);
 }
 
@@ -94,11 +93,8 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2R
                       fmi2Boolean noSetFMUStatePriorToCurrentPoint) {
     (void)noSetFMUStatePriorToCurrentPoint;
     INSTANCE(c, "fmi2DoStep", INITIALISED);
-    if (!(isfinite(communicationStepSize) && communicationStepSize > 0.0)) {
-        fmi2_log(instance, fmi2Error, "fmi2DoStep: the communication step size must be finite and positive, got %g",
-                 communicationStepSize);
+    if (!fmi2_step_allowed(instance, "fmi2DoStep", currentCommunicationPoint, communicationStepSize))
         return fmi2_leave(instance, fmi2Error);
-    }
     return fmi2_leave(instance, fmi2_model.step(instance, currentCommunicationPoint, communicationStepSize));
 }
 
@@ -124,35 +120,38 @@ GET_SET(Boolean, FMI2_TYPES(FMI2_BOOLEAN), fmi2Boolean)
 GET_SET(String, FMI2_TYPES(FMI2_STRING), fmi2String)
 #undef GET_SET
 
+/* FMU states: a refused one (foreign, freed, forged) is fmi2Error with the instance as it was, its state in
+ * the state machine too (fmi2_leave_unchanged) */
 fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate) {
     INSTANCE(c, "fmi2GetFMUstate", FMI2_ANY_PHASE);
-    return fmi2_leave(instance, fmi2_get_state(instance, FMUstate));
+    return fmi2_leave_unchanged(instance, fmi2_get_state(instance, FMUstate));
 }
 
 fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate) {
     INSTANCE(c, "fmi2SetFMUstate", FMI2_ANY_PHASE);
-    return fmi2_leave(instance, fmi2_set_state(instance, FMUstate));
+    return fmi2_leave_unchanged(instance, fmi2_set_state(instance, FMUstate));
 }
 
 fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *FMUstate) {
     INSTANCE(c, "fmi2FreeFMUstate", FMI2_ANY_PHASE);
-    return fmi2_leave(instance, fmi2_free_state(instance, FMUstate));
+    return fmi2_leave_unchanged(instance, fmi2_free_state(instance, FMUstate));
 }
 
 fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate, size_t *size) {
     INSTANCE(c, "fmi2SerializedFMUstateSize", FMI2_ANY_PHASE);
-    return fmi2_leave(instance, fmi2_serialized_size(instance, FMUstate, size));
+    return fmi2_leave_unchanged(instance, fmi2_serialized_size(instance, FMUstate, size));
 }
 
 fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byte serializedState[], size_t size) {
     INSTANCE(c, "fmi2SerializeFMUstate", FMI2_ANY_PHASE);
-    return fmi2_leave(instance, fmi2_serialize(instance, FMUstate, serializedState, size));
+    return fmi2_leave_unchanged(instance, fmi2_serialize(instance, FMUstate, serializedState, size));
 }
 
 fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[], size_t size,
                                    fmi2FMUstate *FMUstate) {
     INSTANCE(c, "fmi2DeSerializeFMUstate", FMI2_ANY_PHASE);
-    return fmi2_leave(instance, fmi2_deserialize(instance, serializedState, size, FMUstate));
+    return fmi2_leave_unchanged(instance,
+                                fmi2_deserialize(instance, serializedState, size, FMUstate));
 }
 
 /* what the model description says this FMU does not provide */

@@ -1,6 +1,7 @@
 /* instance.c: an FMU instance's life, its state machine and its logging (instance.h). */
 #include "instance.h"
 
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -122,11 +123,27 @@ void fmi2_instance_reset(Fmi2Instance *instance) {
         }
     }
     instance->phase = FMI2_INSTANTIATED;
+    instance->time = 0.0;
+}
+
+size_t fmi2_data_size(void) {
+    size_t offsets[5];
+    return layout(offsets);
+}
+
+void fmi2_instance_bind(Fmi2Instance *instance, unsigned char *data) {
+    size_t offsets[5];
+    instance->data = data;
+    instance->data_size = layout(offsets);
+    instance->reals = (fmi2Real *)(void *)(data + offsets[0]);
+    instance->integers = (fmi2Integer *)(void *)(data + offsets[1]);
+    instance->booleans = (fmi2Boolean *)(void *)(data + offsets[2]);
+    instance->strings = (char (*)[FMI2_STRING_SIZE])(void *)(data + offsets[3]);
+    instance->state = data + offsets[4];
 }
 
 Fmi2Instance *fmi2_instance_new(fmi2String name, const fmi2CallbackFunctions *functions, fmi2Boolean logging_on) {
-    size_t offsets[5];
-    size_t size = layout(offsets);
+    size_t size = fmi2_data_size();
     Fmi2Instance *instance = calloc(1, sizeof *instance);
     unsigned char *data = calloc(1, size ? size : 1);
     char *copy = malloc(strlen(name ? name : "") + 1);
@@ -140,19 +157,14 @@ Fmi2Instance *fmi2_instance_new(fmi2String name, const fmi2CallbackFunctions *fu
     strcpy(copy, name ? name : "");
     instance->name = copy;
     instance->callbacks = *functions;
-    instance->data = data;
-    instance->data_size = size;
-    instance->reals = (fmi2Real *)(void *)(data + offsets[0]);
-    instance->integers = (fmi2Integer *)(void *)(data + offsets[1]);
-    instance->booleans = (fmi2Boolean *)(void *)(data + offsets[2]);
-    instance->strings = (char (*)[FMI2_STRING_SIZE])(void *)(data + offsets[3]);
-    instance->state = data + offsets[4];
+    fmi2_instance_bind(instance, data);
     fmi2_set_debug_logging(instance, logging_on, 0, NULL);
     fmi2_instance_reset(instance);
     return instance;
 }
 
 void fmi2_instance_free(Fmi2Instance *instance) {
+    fmi2_free_states(instance);
     free(instance->data);
     free(instance->name);
     free(instance);
@@ -174,8 +186,19 @@ int fmi2_enter(Fmi2Instance *instance, const char *call, unsigned allowed) {
     return 0;
 }
 
+fmi2Status fmi2_leave_unchanged(Fmi2Instance *instance, fmi2Status status) {
+    return instance->logged > status ? instance->logged : status;
+}
+
 fmi2Status fmi2_leave(Fmi2Instance *instance, fmi2Status status) {
     if (instance->logged > status) status = instance->logged;
     if (status >= fmi2Error) instance->phase = FMI2_ERROR;
     return status;
+}
+
+int fmi2_step_allowed(Fmi2Instance *instance, const char *call, double t, double h) {
+    if (isfinite(t) && isfinite(h) && h > 0.0) return 1;
+    fmi2_log(instance, fmi2Error, "%s: a step from t = %.17g s over %.17g s: t must be finite and the communication "
+             "step size finite and positive; the instance unchanged", call, t, h);
+    return 0;
 }

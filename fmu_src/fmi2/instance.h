@@ -24,6 +24,11 @@ typedef enum {
 /* A new instance with its values at their start values, or NULL (logged through functions). */
 Fmi2Instance *fmi2_instance_new(fmi2String name, const fmi2CallbackFunctions *functions, fmi2Boolean logging_on);
 void fmi2_instance_free(Fmi2Instance *instance);
+/* The bytes of an instance's data block (its values and the model's state). */
+size_t fmi2_data_size(void);
+/* instance's data and its values' and the model's state's places within it: data, fmi2_data_size() bytes
+ * (an FMU state's, to read as an instance's). */
+void fmi2_instance_bind(Fmi2Instance *instance, unsigned char *data);
 /* Back to FMI2_INSTANTIATED: start values, the model's state zero. */
 void fmi2_instance_reset(Fmi2Instance *instance);
 
@@ -33,6 +38,13 @@ int fmi2_enter(Fmi2Instance *instance, const char *call, unsigned allowed);
 /* The end of a call: status raised to what the call logged; fmi2Error or worse leaves the
  * instance in FMI2_ERROR. */
 fmi2Status fmi2_leave(Fmi2Instance *instance, fmi2Status status);
+/* The end of a call that refuses what it is given without harm to the instance (a foreign or forged FMU
+ * state): status raised to what the call logged, the instance left in its state. */
+fmi2Status fmi2_leave_unchanged(Fmi2Instance *instance, fmi2Status status);
+
+/* Whether a step from t over h (s) can be given to the model: t and h finite, h > 0; else 0 with an error
+ * logged. (A step whose end t + h overflows is the model's to refuse, in its words.) */
+int fmi2_step_allowed(Fmi2Instance *instance, const char *call, double t, double h);
 
 /* Turn debug logging on or off for the named categories (all for n == 0); an unknown name is
  * logged as a warning. */
@@ -46,5 +58,8 @@ void fmi2_log_to(const fmi2CallbackFunctions *functions, fmi2String name, fmi2St
     ;
 
 const char *fmi2_phase_name(int phase);
+
+/* Free the FMU states the instance still holds (fmi2FreeInstance). */
+void fmi2_free_states(Fmi2Instance *instance);
 
 #endif

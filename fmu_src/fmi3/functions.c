@@ -25,6 +25,10 @@
     if (!instance) return fmi3Error;                                                                               \
     if (!fmi2_enter(instance, call, allowed)) return fmi3Error
 
+/* the most value references a call takes (a variable's may repeat): far more than any importer passes, so
+ * that no count overflows what is sized by it */
+#define MAX_COUNT ((size_t)1 << 24)
+
 static fmi3Status leave(Fmi2Instance *instance, fmi2Status status) { return (fmi3Status)fmi2_leave(instance, status); }
 
 const char *fmi3GetVersion(void) { return fmi3Version; }
@@ -93,7 +97,7 @@ fmi3Status fmi3EnterInitializationMode(fmi3Instance c, fmi3Boolean toleranceDefi
                                        fmi3Float64 startTime, fmi3Boolean stopTimeDefined, fmi3Float64 stopTime) {
     (void)toleranceDefined, (void)tolerance, (void)stopTimeDefined, (void)stopTime;
     INSTANCE(c, "fmi3EnterInitializationMode", FMI2_IN(FMI2_INSTANTIATED));
-    fmi3_context(instance)->time = startTime;
+    instance->time = startTime;
     instance->phase = FMI2_INITIALIZATION_MODE;
     return leave(instance, fmi2OK);
 }
@@ -114,7 +118,6 @@ fmi3Status fmi3Terminate(fmi3Instance c) {
 fmi3Status fmi3Reset(fmi3Instance c) {
     INSTANCE(c, "fmi3Reset", FMI2_ANY_PHASE);
     fmi2_instance_reset(instance);
-    fmi3_context(instance)->time = 0.0;
     return leave(instance, fmi2OK);
 }
 
@@ -127,21 +130,31 @@ fmi3Status fmi3DoStep(fmi3Instance c, fmi3Float64 currentCommunicationPoint, fmi
     if (terminateSimulation) *terminateSimulation = false;
     if (earlyReturn) *earlyReturn = false;
     if (lastSuccessfulTime) *lastSuccessfulTime = currentCommunicationPoint;
-    if (!(isfinite(communicationStepSize) && communicationStepSize > 0.0)) {
-        fmi2_log(instance, fmi2Error, "fmi3DoStep: the communication step size must be finite and positive, got %g",
-                 communicationStepSize);
+    if (!fmi2_step_allowed(instance, "fmi3DoStep", currentCommunicationPoint, communicationStepSize))
         return leave(instance, fmi2Error);
-    }
     fmi2Status status = fmi2_model.step(instance, currentCommunicationPoint, communicationStepSize);
     if (status < fmi2Error) {
-        fmi3_context(instance)->time = currentCommunicationPoint + communicationStepSize;
-        if (lastSuccessfulTime) *lastSuccessfulTime = fmi3_context(instance)->time;
+        instance->time = currentCommunicationPoint + communicationStepSize;
+        if (lastSuccessfulTime) *lastSuccessfulTime = instance->time;
     }
     return leave(instance, status);
 }
 
-static int counts_match(Fmi2Instance *instance, const char *call, size_t nvr, size_t n_values) {
-    if (nvr == n_values) return 1;
+/* whether the call's nvr value references and n_values values (arrays vr, values) can be taken: as many, a
+ * count within MAX_COUNT, arrays given; else 0 with the error logged */
+static int counts_match(Fmi2Instance *instance, const char *call, size_t nvr, size_t n_values, const void *vr,
+                        const void *values) {
+    if (nvr == n_values && nvr <= MAX_COUNT && (nvr == 0 || (vr && values))) return 1;
+    if (nvr == n_values && nvr <= MAX_COUNT) {
+        fmi2_log(instance, fmi2Error, "%s: NULL value references or values for %lu variables", call,
+                 (unsigned long)nvr);
+        return 0;
+    }
+    if (nvr == n_values) {
+        fmi2_log(instance, fmi2Error, "%s: %lu value references: more than the %lu a call takes", call,
+                 (unsigned long)nvr, (unsigned long)MAX_COUNT);
+        return 0;
+    }
     fmi2_log(instance, fmi2Error, "%s: %lu values for %lu value references (every variable here is a scalar)", call,
              (unsigned long)n_values, (unsigned long)nvr);
     return 0;
@@ -150,9 +163,9 @@ static int counts_match(Fmi2Instance *instance, const char *call, size_t nvr, si
 fmi3Status fmi3GetFloat64(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, fmi3Float64 values[],
                           size_t nValues) {
     INSTANCE(c, "fmi3GetFloat64", GETTABLE);
-    if (!counts_match(instance, "fmi3GetFloat64", nvr, nValues)) return leave(instance, fmi2Error);
+    if (!counts_match(instance, "fmi3GetFloat64", nvr, nValues, vr, values)) return leave(instance, fmi2Error);
     for (size_t i = 0; i < nvr; i++) {
-        if (vr[i] == FMI3_TIME_VR) values[i] = fmi3_context(instance)->time;
+        if (vr[i] == FMI3_TIME_VR) values[i] = instance->time;
         else if (fmi2_get_values(instance, "fmi3GetFloat64", FMI2_TYPES(FMI2_REAL), &vr[i], 1, &values[i]) != fmi2OK)
             return leave(instance, fmi2Error);
     }
@@ -162,7 +175,7 @@ fmi3Status fmi3GetFloat64(fmi3Instance c, const fmi3ValueReference vr[], size_t 
 fmi3Status fmi3SetFloat64(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, const fmi3Float64 values[],
                           size_t nValues) {
     INSTANCE(c, "fmi3SetFloat64", SETTABLE);
-    if (!counts_match(instance, "fmi3SetFloat64", nvr, nValues)) return leave(instance, fmi2Error);
+    if (!counts_match(instance, "fmi3SetFloat64", nvr, nValues, vr, values)) return leave(instance, fmi2Error);
     for (size_t i = 0; i < nvr; i++)
         if (vr[i] == FMI3_TIME_VR) {
             fmi2_log(instance, fmi2Error, "fmi3SetFloat64: time is the independent variable: it cannot be set");
@@ -174,14 +187,14 @@ fmi3Status fmi3SetFloat64(fmi3Instance c, const fmi3ValueReference vr[], size_t 
 fmi3Status fmi3GetString(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, fmi3String values[],
                          size_t nValues) {
     INSTANCE(c, "fmi3GetString", GETTABLE);
-    if (!counts_match(instance, "fmi3GetString", nvr, nValues)) return leave(instance, fmi2Error);
+    if (!counts_match(instance, "fmi3GetString", nvr, nValues, vr, values)) return leave(instance, fmi2Error);
     return leave(instance, fmi2_get_values(instance, "fmi3GetString", FMI2_TYPES(FMI2_STRING), vr, nvr, values));
 }
 
 fmi3Status fmi3SetString(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, const fmi3String values[],
                          size_t nValues) {
     INSTANCE(c, "fmi3SetString", SETTABLE);
-    if (!counts_match(instance, "fmi3SetString", nvr, nValues)) return leave(instance, fmi2Error);
+    if (!counts_match(instance, "fmi3SetString", nvr, nValues, vr, values)) return leave(instance, fmi2Error);
     return leave(instance, fmi2_set_values(instance, "fmi3SetString", FMI2_TYPES(FMI2_STRING), vr, nvr, values));
 }
 
@@ -192,7 +205,8 @@ fmi3Status fmi3SetString(fmi3Instance c, const fmi3ValueReference vr[], size_t n
     fmi3Status fmi3Get##Type(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, type values[],             \
                              size_t nValues) {                                                                     \
         INSTANCE(c, "fmi3Get" #Type, GETTABLE);                                                                    \
-        if (!counts_match(instance, "fmi3Get" #Type, nvr, nValues)) return leave(instance, fmi2Error);            \
+        if (!counts_match(instance, "fmi3Get" #Type, nvr, nValues, vr, values))                                    \
+            return leave(instance, fmi2Error);                                                                     \
         for (size_t i = 0; i < nvr; i++) {                                                                         \
             held value;                                                                                            \
             if (fmi2_get_values(instance, "fmi3Get" #Type, TYPES, &vr[i], 1, &value) != fmi2OK)                    \
@@ -204,7 +218,8 @@ fmi3Status fmi3SetString(fmi3Instance c, const fmi3ValueReference vr[], size_t n
     fmi3Status fmi3Set##Type(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, const type values[],       \
                              size_t nValues) {                                                                     \
         INSTANCE(c, "fmi3Set" #Type, SETTABLE);                                                                    \
-        if (!counts_match(instance, "fmi3Set" #Type, nvr, nValues)) return leave(instance, fmi2Error);            \
+        if (!counts_match(instance, "fmi3Set" #Type, nvr, nValues, vr, values))                                    \
+            return leave(instance, fmi2Error);                                                                     \
         held *copy = malloc((nvr ? nvr : 1) * sizeof *copy);                                                       \
         if (!copy) {                                                                                               \
             fmi2_log(instance, fmi2Error, "fmi3Set" #Type ": out of memory");                                      \
@@ -282,35 +297,38 @@ fmi3Status fmi3SetClock(fmi3Instance c, const fmi3ValueReference vr[], size_t nv
     return no_such_type(c, "fmi3SetClock", vr, nvr);
 }
 
+/* FMU states: a refused one is fmi3Error with the instance as it was (fmi2_leave_unchanged) */
 fmi3Status fmi3GetFMUState(fmi3Instance c, fmi3FMUState *FMUState) {
     INSTANCE(c, "fmi3GetFMUState", FMI2_ANY_PHASE);
-    return leave(instance, fmi2_get_state(instance, FMUState));
+    return (fmi3Status)fmi2_leave_unchanged(instance, fmi2_get_state(instance, FMUState));
 }
 
 fmi3Status fmi3SetFMUState(fmi3Instance c, fmi3FMUState FMUState) {
     INSTANCE(c, "fmi3SetFMUState", FMI2_ANY_PHASE);
-    return leave(instance, fmi2_set_state(instance, FMUState));
+    return (fmi3Status)fmi2_leave_unchanged(instance, fmi2_set_state(instance, FMUState));
 }
 
 fmi3Status fmi3FreeFMUState(fmi3Instance c, fmi3FMUState *FMUState) {
     INSTANCE(c, "fmi3FreeFMUState", FMI2_ANY_PHASE);
-    return leave(instance, fmi2_free_state(instance, FMUState));
+    return (fmi3Status)fmi2_leave_unchanged(instance, fmi2_free_state(instance, FMUState));
 }
 
 fmi3Status fmi3SerializedFMUStateSize(fmi3Instance c, fmi3FMUState FMUState, size_t *size) {
     INSTANCE(c, "fmi3SerializedFMUStateSize", FMI2_ANY_PHASE);
-    return leave(instance, fmi2_serialized_size(instance, FMUState, size));
+    return (fmi3Status)fmi2_leave_unchanged(instance, fmi2_serialized_size(instance, FMUState, size));
 }
 
 fmi3Status fmi3SerializeFMUState(fmi3Instance c, fmi3FMUState FMUState, fmi3Byte serializedState[], size_t size) {
     INSTANCE(c, "fmi3SerializeFMUState", FMI2_ANY_PHASE);
-    return leave(instance, fmi2_serialize(instance, FMUState, (fmi2Byte *)serializedState, size));
+    return (fmi3Status)fmi2_leave_unchanged(instance,
+                                            fmi2_serialize(instance, FMUState, (fmi2Byte *)serializedState, size));
 }
 
 fmi3Status fmi3DeserializeFMUState(fmi3Instance c, const fmi3Byte serializedState[], size_t size,
                                    fmi3FMUState *FMUState) {
     INSTANCE(c, "fmi3DeserializeFMUState", FMI2_ANY_PHASE);
-    return leave(instance, fmi2_deserialize(instance, (const fmi2Byte *)serializedState, size, FMUState));
+    return (fmi3Status)fmi2_leave_unchanged(
+        instance, fmi2_deserialize(instance, (const fmi2Byte *)serializedState, size, FMUState));
 }
 
 /* what the model description says this FMU does not provide */

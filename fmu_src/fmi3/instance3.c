@@ -37,7 +37,7 @@ Fmi2Instance *fmi3_instance_new(fmi3String name, fmi3Boolean logging_on, fmi3Ins
         fmi3_log_to(environment, log_message, name, fmi3Error, "fmi3InstantiateCoSimulation: out of memory");
         return NULL;
     }
-    *context = (Fmi3Context){environment, log_message, 0.0};
+    *context = (Fmi3Context){environment, log_message};
     fmi2CallbackFunctions callbacks = {log_message ? forward : NULL, NULL, NULL, NULL, context};
     Fmi2Instance *instance = fmi2_instance_new(name, &callbacks, logging_on ? fmi2True : fmi2False);
     if (!instance) free(context);

@@ -13,9 +13,6 @@
 typedef struct {
     fmi3InstanceEnvironment environment;
     fmi3LogMessageCallback log_message;
-    /* the independent variable `time` (s): the start time, then the end of each step taken (an FMU
-     * state restored does not take it back: FMU states hold the values and the model's state) */
-    fmi3Float64 time;
 } Fmi3Context;
 
 #define FMI3_TIME_VR ((fmi3ValueReference)fmi2_model.n_variables) /* `time`, after the table's variables */

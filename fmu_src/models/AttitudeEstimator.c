@@ -12,6 +12,7 @@
 #include "stages/timing.h"
 
 #define MESSAGE_SIZE 1024
+#define LONG_STEP_S 1.0 /* steps longer than this keep the state to fall back on whatever their length */
 
 typedef struct {
     AfOnline estimator;
@@ -70,11 +71,40 @@ static void put(fmi2Real *to, const double *from, int n) {
     for (int i = 0; i < n; i++) to[i] = from[i];
 }
 
+/* whether the estimate's outputs are all finite */
+static int outputs_finite(const AfOnline *est) {
+    const double *groups[] = {est->quat, est->up, est->euler, est->offset, est->mag_offset, &est->mag_delay};
+    const int sizes[] = {4, 3, 3, 3, 3, 1};
+    for (int g = 0; g < 6; g++)
+        for (int i = 0; i < sizes[g]; i++)
+            if (!isfinite(groups[g][i])) return 0;
+    return 1;
+}
+
+static int validate(const void *state, const void *configured, char *message, size_t size) {
+    const Model *model = state;
+    if (model->noted_step != 0 && model->noted_step != 1)
+        return refuse(message, size, "the flag 'noted_step' is %d, not 0 or 1", model->noted_step);
+    return af_online_validate(&model->estimator, &((const Model *)configured)->estimator, message, size);
+}
+
 static fmi2Status step(Fmi2Instance *instance, fmi2Real t, fmi2Real h) {
     Model *model = instance->state;
     AfOnline *est = &model->estimator;
     fmi2Real *r = instance->reals;
     fmi2Status status = fmi2OK;
+    char message[MESSAGE_SIZE], a[FLOAT_REPR_SIZE], b[FLOAT_REPR_SIZE];
+    if (!isfinite(t + h)) {
+        fmi2_log(instance, fmi2Error, "a step of %s s to %s s overflows the estimator's arithmetic; the estimate held",
+                 float_repr(h, a), float_repr(t + h, b));
+        return fmi2Error;
+    }
+    /* What a step the arithmetic cannot take leaves: kept where the step is new to the filter (it is
+     * re-discretised for it) or longer than LONG_STEP_S; a step of the length the filter was discretised
+     * for, on inputs in every IMU's range, keeps its outputs finite, and is not slowed by the copy. */
+    Model before;
+    const int keep = !(est->discretised && same_step(h, est->step.Ts)) || h > LONG_STEP_S;
+    if (keep) before = *model;
     if (!model->noted_step && !same_step(h, r[REAL_Ts])) {
         model->noted_step = 1;
         fmi2_log(instance, fmi2OK, "communication step %g s differs from Ts = %g s: filter re-discretised for it "
@@ -84,10 +114,16 @@ static fmi2Status step(Fmi2Instance *instance, fmi2Real t, fmi2Real h) {
     const double gyr[3] = {r[REAL_gyr_x], r[REAL_gyr_y], r[REAL_gyr_z]};
     const double acc[3] = {r[REAL_acc_x], r[REAL_acc_y], r[REAL_acc_z]};
     const double mag[3] = {r[REAL_mag_x], r[REAL_mag_y], r[REAL_mag_z]};
-    char message[MESSAGE_SIZE];
     int taken = af_online_step(est, gyr, acc, mag, h, message, sizeof message);
     if (taken < 0) {
+        if (keep) *model = before;
         fmi2_log(instance, fmi2Error, "%s", message);
+        return fmi2Error;
+    }
+    if (taken == 1 && !outputs_finite(est)) {
+        if (keep) *model = before;
+        fmi2_log(instance, fmi2Error, "a step of %s s to %s s overflows the estimator's arithmetic; the estimate held",
+                 float_repr(h, a), float_repr(t + h, b));
         return fmi2Error;
     }
     instance->booleans[BOOLEAN_valid] = taken == 1;
@@ -110,5 +146,5 @@ static fmi2Status step(Fmi2Instance *instance, fmi2Real t, fmi2Real h) {
 
 const Fmi2Model fmi2_model = {
     MODEL_IDENTIFIER, MODEL_GUID, MODEL_VARIABLES, N_VARIABLES, N_REALS, N_INTEGERS, N_BOOLEANS, N_STRINGS,
-    MODEL_LOG_CATEGORIES, N_LOG_CATEGORIES, sizeof(Model), initialise, step,
+    MODEL_LOG_CATEGORIES, N_LOG_CATEGORIES, sizeof(Model), initialise, step, validate,
 };

@@ -4,7 +4,9 @@
  * streams SENSOR and MAGNETOMETER of `seed`, as ImuModel.apply and apply_mag draw them.
  * The pythonfmu ImuSensor (fmu_src/ImuSensor.py) runs the same C core with the same checks,
  * messages and statuses. */
+#include <math.h>
 #include <stdint.h>
+#include <string.h>
 
 #include "ImuSensor_variables.h"
 #include "messages.h"
@@ -49,11 +51,26 @@ static fmi2Status initialise(Fmi2Instance *instance) {
     return fmi2OK;
 }
 
+static int validate(const void *state, const void *configured, char *message, size_t size) {
+    const Model *model = state, *own = configured;
+    if (memcmp(&model->params, &own->params, sizeof own->params) != 0 || model->seed != own->seed)
+        return refuse(message, size, "the sensor's parameters or seed are not those of its configuration");
+    if (!model->params.latency || model->k == 0) return 0; /* no delay line in use */
+    if (!(isfinite(model->step_size) && model->step_size > 0.0 && isfinite(1.0 / model->step_size)))
+        return refuse(message, size, "the sensor's step size is not a finite positive number of seconds");
+    return delay_validate(&model->delay, model->params.latency, 1.0 / model->step_size, message, size);
+}
+
 static fmi2Status step(Fmi2Instance *instance, fmi2Real t, fmi2Real h) {
-    (void)t;
     Model *model = instance->state;
     fmi2Real *r = instance->reals;
     double signals[DELAY_WIDTH], late[DELAY_WIDTH], noise[SENSOR_WIDTH], mag_noise[MAGNETOMETER_WIDTH];
+    if (!isfinite(1.0 / h) || !isfinite(t + h)) { /* a sample rate or an end beyond the arithmetic's range */
+        char a[FLOAT_REPR_SIZE], b[FLOAT_REPR_SIZE];
+        fmi2_log(instance, fmi2Error, "a step of %s s to %s s overflows the sensor's arithmetic", float_repr(h, a),
+                 float_repr(t + h, b));
+        return fmi2Error;
+    }
     for (int i = 0; i < 3; i++) signals[i] = r[REAL_omega_x + i], signals[3 + i] = r[REAL_f_x + i];
     const double *measured = signals;
     if (model->params.latency) {
@@ -82,5 +99,5 @@ static fmi2Status step(Fmi2Instance *instance, fmi2Real t, fmi2Real h) {
 
 const Fmi2Model fmi2_model = {
     MODEL_IDENTIFIER, MODEL_GUID, MODEL_VARIABLES, N_VARIABLES, N_REALS, N_INTEGERS, N_BOOLEANS, N_STRINGS,
-    MODEL_LOG_CATEGORIES, N_LOG_CATEGORIES, sizeof(Model), initialise, step,
+    MODEL_LOG_CATEGORIES, N_LOG_CATEGORIES, sizeof(Model), initialise, step, validate,
 };

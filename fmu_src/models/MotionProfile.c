@@ -92,6 +92,17 @@ static fmi2Status initialise(Fmi2Instance *instance) {
     return fmi2OK;
 }
 
+static int validate(const void *state, const void *configured, char *message, size_t size) {
+    const Model *model = state, *own = configured;
+    if (model->human != own->human)
+        return refuse(message, size, "the flag 'human' is %d, not its profile's %d", model->human, own->human);
+    if (memcmp(&model->closed, &own->closed, sizeof own->closed) != 0) /* a human motion's: all 0 */
+        return refuse(message, size, "the closed form is not that of its profile and parameters");
+    if (!model->human) return memcmp(&model->stream, &own->stream, sizeof own->stream) == 0 ? 0 :
+        refuse(message, size, "a closed form's state holds a human motion");
+    return human_stream_validate(&model->stream, &own->stream, message, size);
+}
+
 /* the outputs of the interval (t, t + h]; where the step's arithmetic leaves them not finite, or the human
  * motion refuses the step, fmi2Error with the reason and the outputs as they were */
 static fmi2Status step(Fmi2Instance *instance, fmi2Real t, fmi2Real h) {
@@ -99,6 +110,7 @@ static fmi2Status step(Fmi2Instance *instance, fmi2Real t, fmi2Real h) {
     fmi2Real *r = instance->reals;
     double out[HUMAN_N_OUT + 3];
     char message[MESSAGE_SIZE], a[FLOAT_REPR_SIZE], b[FLOAT_REPR_SIZE];
+    const HumanStream before = model->stream; /* what a step the arithmetic cannot take leaves */
     if (model->human) {
         if (human_stream_step(&model->stream, t, t + h, out, message, sizeof message) != 0) {
             fmi2_log(instance, fmi2Error, "%s", message);
@@ -108,6 +120,7 @@ static fmi2Status step(Fmi2Instance *instance, fmi2Real t, fmi2Real h) {
     earth_field_in_sensor(out + 6, out + HUMAN_N_OUT);
     for (int i = 0; i < HUMAN_N_OUT + 3; i++)
         if (!isfinite(out[i])) {
+            model->stream = before;
             fmi2_log(instance, fmi2Error, "a step of %s s to %s s overflows the motion's arithmetic",
                      float_repr(h, a), float_repr(t + h, b));
             return fmi2Error;
@@ -120,5 +133,5 @@ static fmi2Status step(Fmi2Instance *instance, fmi2Real t, fmi2Real h) {
 
 const Fmi2Model fmi2_model = {
     MODEL_IDENTIFIER, MODEL_GUID, MODEL_VARIABLES, N_VARIABLES, N_REALS, N_INTEGERS, N_BOOLEANS, N_STRINGS,
-    MODEL_LOG_CATEGORIES, N_LOG_CATEGORIES, sizeof(Model), initialise, step,
+    MODEL_LOG_CATEGORIES, N_LOG_CATEGORIES, sizeof(Model), initialise, step, validate,
 };

@@ -13,6 +13,7 @@ the same SSP in a second importer, independent of fmpy (libcosim).
 """
 from __future__ import annotations
 
+import os
 import shutil
 from collections import defaultdict
 from pathlib import Path
@@ -90,7 +91,14 @@ class _Component:
         self.md = read_model_description(fmu_path)
         self.variables = {v.name: v for v in self.md.modelVariables}
         self.unzipdir = extract(fmu_path)
-        self.fmu = load_slave(self.md, self.unzipdir, element.name)
+        cwd = os.getcwd()  # fmpy enters the binary's folder to load it, and stays there where that fails
+        try:
+            self.fmu = load_slave(self.md, self.unzipdir, element.name)
+        except Exception as exc:  # a binary that does not load (another platform's, broken): its folder goes
+            os.chdir(cwd)
+            shutil.rmtree(self.unzipdir, ignore_errors=True)
+            raise RuntimeError(f"component {element.name}: its binary ({element.source}) failed to load: {exc}"
+                               ) from exc
         self.outputs = [v.name for v in self.md.modelVariables if v.causality == "output"]
         self.real_out = [n for n in self.outputs if self.variables[n].type == "Real"]
         self.bool_out = [n for n in self.outputs if self.variables[n].type == "Boolean"]
@@ -103,10 +111,19 @@ class _Component:
         self.fmu.setupExperiment(startTime=start_time)
         self.fmu.enterInitializationMode()
         for p in parameters:  # an SSD's values are text (an Enumeration's: its item's value or name)
-            variable = self.variables[p.name]
+            variable = self.variable(p.name, "a parameter binding")
             set_value(self.fmu, variable, int(p.value) if p.type == "Integer" else p.value)
         self.fmu.exitInitializationMode()
         self.input_vr = [self.variables[name].valueReference for name, _, _ in self.inputs]
+
+    def variable(self, name: str, what: str, causality: str | None = None):
+        """The variable name (of causality, where given) of fmpy's model description; ValueError naming
+        the component, the variable and what named it (what) where it has none."""
+        variable = self.variables.get(name)
+        if variable is None or (causality is not None and variable.causality != causality):
+            kind = f"{causality} variable" if causality else "variable"
+            raise ValueError(f"component {self.name} has no {kind} {name!r} ({what} names it)")
+        return variable
 
     def stop(self):
         self.fmu.terminate()
@@ -127,7 +144,7 @@ def cosimulate(ssp_path, stop_time: float, step_size: float, progress=None) -> d
         for element in ssd.system.elements:
             components[element.name] = _Component(element, ssp_dir)
         for c in ssd.system.connections:
-            components[c.endElement].inputs.append((c.endConnector, c.startElement, c.startConnector))
+            _connect(components, c)
         order = _stepping_order(components)
         for element in ssd.system.elements:
             params = [p for b in element.parameterBindings for s in b.parameterValues for p in s.parameters]
@@ -150,6 +167,20 @@ def cosimulate(ssp_path, stop_time: float, step_size: float, progress=None) -> d
             except Exception:  # an instance that never started has nothing to free
                 shutil.rmtree(comp.unzipdir, ignore_errors=True)
         shutil.rmtree(ssp_dir, ignore_errors=True)
+
+
+def _connect(components: dict, c) -> None:
+    """The connection c of the SSD: its start an output of a component, its end an input of another;
+    ValueError naming what is missing."""
+    where = f"the connection {c.startElement}.{c.startConnector} -> {c.endElement}.{c.endConnector}"
+    for element in (c.startElement, c.endElement):
+        if element not in components:
+            raise ValueError(f"{where} names a component the SSD does not have: {element!r}")
+    source = components[c.startElement]
+    if source.variable(c.startConnector, where, "output").type not in ("Real", "Boolean"):
+        raise ValueError(f"{where}: {c.startElement}.{c.startConnector} is neither Real nor Boolean")
+    components[c.endElement].variable(c.endConnector, where, "input")
+    components[c.endElement].inputs.append((c.endConnector, c.startElement, c.startConnector))
 
 
 def _steps(order, columns, n: int, h: float, progress) -> np.ndarray:

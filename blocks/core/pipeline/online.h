@@ -62,6 +62,13 @@ int af_online_discretise(AfOnline *est, double Ts, const AfZoh *zoh, char *messa
 int af_online_step_with(AfOnline *est, const double gyr[3], const double acc[3], const double mag[3], double Ts,
                         const AfZoh *zoh, char *message, size_t size);
 
+/* Whether est (bytes nobody vouches for, e.g. an FMU state's) is an estimator of the configuration
+ * configured (af_online_init's from the same parameters, not discretised) that can step: its
+ * pipeline configured's, bit for bit; its discretisation (if any) the core's own of that pipeline at
+ * its Ts; every flag 0 or 1; the stages' states and the outputs finite; the method's quaternion a
+ * unit one once started. 0, or -1 with the first field refused in message. */
+int af_online_validate(const AfOnline *est, const AfOnline *configured, char *message, size_t size);
+
 /* af_online_step_with the core's own discretisation. */
 int af_online_step(AfOnline *est, const double gyr[3], const double acc[3], const double mag[3], double Ts,
                    char *message, size_t size);

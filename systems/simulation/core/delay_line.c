@@ -52,3 +52,16 @@ void delay_load(DelayLine *line, const double *past) {
     for (int r = 0; r < line->rows - 1; r++)
         for (int i = 0; i < DELAY_WIDTH; i++) line->x[line->head - r][i] = past[DELAY_WIDTH * r + i];
 }
+
+int delay_validate(const DelayLine *line, double latency, double fs, char *message, size_t size) {
+    double samples = floor(latency * fs);
+    if (!(samples >= 0.0 && samples < DELAY_MAX_ROWS - 2) || line->latency != latency || line->fs != fs)
+        return refuse(message, size, "the delay line is not one for its latency and sample rate");
+    if (line->rows != (int)samples + 2 || line->head < 0 || line->head >= line->rows)
+        return refuse(message, size, "the delay line's rows (%d) or head (%d) are out of their range", line->rows,
+                      line->head);
+    for (int r = 0; r < line->rows; r++)
+        for (int i = 0; i < DELAY_WIDTH; i++)
+            if (!isfinite(line->x[r][i])) return refuse(message, size, "the delay line holds values not finite");
+    return 0;
+}

@@ -22,6 +22,10 @@ typedef struct {
  * 0, or -1 with a message where latency*fs is not 0 or more samples or too long for it */
 int delay_init(DelayLine *line, double latency, double fs, const double before[DELAY_WIDTH], char *message,
                size_t size);
+/* whether line (bytes nobody vouches for, e.g. an FMU state's) is the line delay_init makes for latency
+ * (s) at fs (Hz), stepped on: its latency and fs those, its rows theirs, its head one of them, the rows in
+ * use finite. 0, or -1 with a message. */
+int delay_validate(const DelayLine *line, double latency, double fs, char *message, size_t size);
 /* this sample's true (omega, f) in, those latency seconds ago out */
 void delay_step(DelayLine *line, const double signals[DELAY_WIDTH], double out[DELAY_WIDTH]);
 /* n samples: signals and out n rows of DELAY_WIDTH (they may be the same array) */

@@ -2,6 +2,7 @@
 #include "human_motion.h"
 
 #include <math.h>
+#include <string.h>
 
 #include "closed_form.h"
 #include "messages.h"
@@ -116,5 +117,32 @@ int human_stream_step(HumanStream *s, double start, double end, double out[HUMAN
     out[3] = f.x, out[4] = f.y, out[5] = f.z;
     quat_store(q, out + 6);
     s->t = end;
+    return 0;
+}
+
+/* whether the 4 doubles at q are a unit quaternion */
+static int unit_quaternion(const double *q) {
+    return fabs(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3] - 1.0) < 1e-6;
+}
+
+int human_stream_validate(const HumanStream *s, const HumanStream *configured, char *message, size_t size) {
+    if (memcmp(&s->params, &configured->params, sizeof s->params) != 0 || s->seed != configured->seed ||
+        memcmp(&s->grid, &configured->grid, sizeof s->grid) != 0 ||
+        memcmp(s->coef, configured->coef, sizeof s->coef) != 0)
+        return refuse(message, size, "the human motion's parameters, seed or grid are not its configuration's");
+    double G = s->grid, cells = (double)s->k;
+    if (!(isfinite(s->t) && s->t >= 0.0))
+        return refuse(message, size, "the human motion's time is not a finite time from 0 s");
+    if (!(cells * G >= s->t * (1.0 - 1e-12) && (cells - 1.0) * G <= s->t + G * (1.0 + 1e-12)) ||
+        (s->k == 0 && s->t != 0.0))
+        return refuse(message, size, "the human motion's grid cells drawn (%.0f) are not those that reach its time",
+                      cells);
+    const double *groups[] = {s->state, s->v0, s->q0, s->acc};
+    const int counts[] = {HUMAN_N_STATES, 3, 4, 3};
+    for (int g = 0; g < 4; g++)
+        for (int i = 0; i < counts[g]; i++)
+            if (!isfinite(groups[g][i])) return refuse(message, size, "the human motion holds values not finite");
+    if (!unit_quaternion(s->state + 6) || !unit_quaternion(s->q0))
+        return refuse(message, size, "the human motion's orientations are not unit quaternions");
     return 0;
 }

@@ -57,4 +57,10 @@ void human_stream_init(HumanStream *stream, const HumanParams *params, double gr
 int human_stream_step(HumanStream *stream, double start, double end, double out[HUMAN_N_OUT], char *message,
                       size_t size);
 
+/* Whether s (bytes nobody vouches for, e.g. an FMU state's) is a stream human_stream_init made as it made
+ * configured, stepped on: its parameters, seed, grid and coefficients configured's, its time t finite and
+ * not negative, its cells drawn those that reach t, its states finite, its quaternions unit ones. 0, or -1
+ * with a message. */
+int human_stream_validate(const HumanStream *s, const HumanStream *configured, char *message, size_t size);
+
 #endif

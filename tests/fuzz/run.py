@@ -1,0 +1,106 @@
+"""The fuzz targets of the FMU states' deserialiser (tests/fuzz/fuzz_state.c, one per model) run for a
+bounded time from the corpus tests/fuzz/corpus/<Model>, with the address and undefined-behaviour
+sanitizers: under libFuzzer where clang has it (CMake option AF_FUZZ), else (libfuzzer=False, or no
+clang) the targets' own driver built by the C compiler with AF_SANITIZE (seeded mutations: bytes
+flipped, fields set to edge values, inputs cut short).
+
+    python -m tests.fuzz.run SECONDS [--driver]    SECONDS per model; exit 1 on a finding
+
+Each run is reported as "<model>: <executions> runs in <s> s, <findings> findings"; a finding is a
+libFuzzer artifact (crash, leak, timeout, out of memory) or, for the driver, a sanitizer's report or
+an abort (a refused state that changed the instance)."""
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+from tests import native
+
+MODELS = ("AttitudeEstimator", "ImuSensor", "MotionProfile")
+CORPUS = Path(__file__).resolve().parent / "corpus"
+MAX_LEN = 65536  # bytes of an input: the largest state (ImuSensor's, its delay line) and then some
+
+
+@dataclass
+class Run:
+    model: str
+    runs: int
+    seconds: float
+    findings: list
+
+    def __str__(self):
+        return f"{self.model}: {self.runs} runs in {self.seconds:.0f} s, {len(self.findings)} findings"
+
+
+def libfuzzer_available() -> bool:
+    """Whether clang is here with libFuzzer's runtime."""
+    clang = shutil.which("clang")
+    if clang is None:
+        return False
+    path = subprocess.run([clang, "-print-file-name=libclang_rt.fuzzer-x86_64.a"], capture_output=True, text=True)
+    return Path(path.stdout.strip()).is_file()
+
+
+def build(libfuzzer: bool) -> Path:
+    """The three fuzz targets built; returns the folder of the executables."""
+    from attitude_fmu.build_fmu import cmake_build
+
+    targets = [f"fuzz_state_{m}" for m in MODELS]
+    if not libfuzzer:
+        return native.build(targets, sanitize=True) / "tests"
+    folder = native.ROOT / "build" / "fuzz"
+    os.environ["CC"] = shutil.which("clang")
+    cmake_build(folder, targets, ("AF_WERROR=ON", "AF_FUZZ=ON", "AF_PYTHON=OFF"), source=native.ROOT)
+    return folder / "tests"
+
+
+def run_libfuzzer(binary: Path, model: str, seconds: float, work: Path) -> Run:
+    fresh = work / model
+    fresh.mkdir()
+    command = [str(binary), f"-max_total_time={int(seconds)}", f"-max_len={MAX_LEN}", "-timeout=20",
+               "-print_final_stats=1", f"-artifact_prefix={work}/{model}-", str(fresh), str(CORPUS / model)]
+    start = time.monotonic()
+    proc = subprocess.run(command, capture_output=True, text=True, timeout=seconds + 300)
+    elapsed = time.monotonic() - start
+    runs = re.search(r"stat::number_of_executed_units:\s*(\d+)", proc.stderr)
+    findings = sorted(str(p) for p in work.glob(f"{model}-*"))
+    if proc.returncode != 0 and not findings:
+        findings = [proc.stderr[-3000:]]
+    return Run(model, int(runs.group(1)) if runs else 0, elapsed, findings)
+
+
+def run_driver(binary: Path, model: str, seconds: float, seed: int = 1) -> Run:
+    inputs = sorted(str(p) for p in (CORPUS / model).iterdir())
+    env = {**os.environ, "ASAN_OPTIONS": "detect_leaks=1", "UBSAN_OPTIONS": "print_stacktrace=1"}
+    start = time.monotonic()
+    proc = subprocess.run([str(binary), str(seconds), str(seed), *inputs], capture_output=True, text=True,
+                          timeout=seconds + 300, env=env)
+    elapsed = time.monotonic() - start
+    runs = re.search(r"runs (\d+)", proc.stdout)
+    reports = [r for r in ("runtime error", "Sanitizer", "fuzz_state:") if r in proc.stderr]
+    findings = [proc.stderr[-3000:]] if proc.returncode != 0 or reports else []
+    return Run(model, int(runs.group(1)) if runs else 0, elapsed, findings)
+
+
+def fuzz(seconds: float, libfuzzer: bool | None = None) -> list[Run]:
+    """Every model's target for seconds from its corpus: libFuzzer's where available (None: where clang
+    has it), else the driver's."""
+    libfuzzer = libfuzzer_available() if libfuzzer is None else libfuzzer
+    folder = build(libfuzzer)
+    with tempfile.TemporaryDirectory() as work:
+        return [run_libfuzzer(folder / f"fuzz_state_{m}", m, seconds, Path(work)) if libfuzzer
+                else run_driver(folder / f"fuzz_state_{m}", m, seconds) for m in MODELS]
+
+
+if __name__ == "__main__":
+    results = fuzz(float(sys.argv[1]), False if "--driver" in sys.argv[2:] else None)
+    for result in results:
+        print(result)
+        for finding in result.findings:
+            print(finding, file=sys.stderr)
+    sys.exit(1 if any(r.findings for r in results) else 0)
