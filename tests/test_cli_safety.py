@@ -230,6 +230,26 @@ def test_a_signal_during_the_write_removes_the_temporary_file(tmp_path, source, 
     assert "Traceback" not in err and _partials(tmp_path) == [] and out.read_text() == "previous\n"
 
 
+def test_sigint_while_the_command_loads_ends_with_one_line_and_exit_130():
+    """SIGINT while the console script (systems.cli.entry) loads the command's modules, which take
+    about a second and a half: one line, exit 130, no traceback. The signal is sent at the import
+    of the command's module, the moment a user's Ctrl-C after typing the command lands in."""
+    script = ("import builtins, os, signal, sys\n"
+              "sys.argv = ['attitude', '--help']\n"
+              "from attitude_fmu.systems.cli import entry\n"
+              "real_import = builtins.__import__\n"
+              "def importing(name, *args, **kwargs):\n"
+              "    if name == 'attitude_fmu.systems.cli.commands':\n"
+              "        os.kill(os.getpid(), signal.SIGINT)\n"
+              "    return real_import(name, *args, **kwargs)\n"
+              "builtins.__import__ = importing\n"
+              "entry.entry_point()\n")
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 130, done.stderr
+    assert done.stderr.splitlines() == ["attitude: interrupted by SIGINT; nothing was written"], done.stderr
+    assert done.stdout == ""  # the command never ran: no help printed
+
+
 def test_sigint_while_reading_ends_with_one_line_and_exit_130(tmp_path):
     """SIGINT while the input (a named pipe its writer holds open) is being read: no output,
     no traceback, one line, exit 130."""
