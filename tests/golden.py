@@ -211,7 +211,8 @@ def simulation_case():
     out.update({"human quat": human.quat, "human gyr": human.gyr, "human acc": human.acc})
     for name in PROFILES:  # the human motion on a grid of one cell per sample: the process frozen here
         motion = profile(name).motion({"grid": 1 / 50.0} if name == "human" else None).generate(3.0, 50.0)
-        out.update({f"{name} quat": motion.quat, f"{name} gyr": motion.gyr, f"{name} acc": motion.acc})
+        out.update({f"profile {name} quat": motion.quat, f"profile {name} gyr": motion.gyr,
+                    f"profile {name} acc": motion.acc})
     model = ImuModel(delta_n=math.radians(0.1), gyr_offset=(0.01, 0.0, -0.02),
                      gyr_scale=((0.01, 0.002, 0.0), (0.0, -0.01, 0.003), (0.001, 0.0, 0.02)), acc_noise=0.02,
                      acc_offset=(0.1, -0.05, 0.0), latency=0.025, mag_noise=0.2, mag_offset=(5.0, -3.0, 1.0))
