@@ -37,26 +37,28 @@ class Run:
         return f"{self.model}: {self.runs} runs in {self.seconds:.0f} s, {len(self.findings)} findings"
 
 
-def libfuzzer_available() -> bool:
-    """Whether clang is here with libFuzzer's runtime."""
-    clang = shutil.which("clang")
-    if clang is None:
-        return False
-    path = subprocess.run([clang, "-print-file-name=libclang_rt.fuzzer-x86_64.a"], capture_output=True, text=True)
-    return Path(path.stdout.strip()).is_file()
-
-
-def build(libfuzzer: bool) -> Path:
-    """The three fuzz targets built; returns the folder of the executables."""
+def build(libfuzzer: bool | None) -> tuple[Path, bool]:
+    """The three fuzz targets built: (the folder of the executables, whether they are libFuzzer's).
+    libFuzzer's with clang (cmake/clang.cmake, AF_FUZZ), where CMake finds clang with libFuzzer (None:
+    the driver's otherwise; True: required); else (False, or none found) their own driver's, built
+    with AF_SANITIZE by tests/native.py."""
     from attitude_fmu.build_fmu import cmake_build
 
     targets = [f"fuzz_state_{m}" for m in MODELS]
-    if not libfuzzer:
-        return native.build(targets, sanitize=True) / "tests"
-    folder = native.ROOT / "build" / "fuzz"
-    os.environ["CC"] = shutil.which("clang")
-    cmake_build(folder, targets, ("AF_WERROR=ON", "AF_FUZZ=ON", "AF_PYTHON=OFF"), source=native.ROOT)
-    return folder / "tests"
+    if libfuzzer is not False:
+        folder = native.ROOT / "build" / "fuzz"
+        options = (f"CMAKE_TOOLCHAIN_FILE={native.ROOT / 'cmake' / 'clang.cmake'}", "AF_WERROR=ON", "AF_FUZZ=ON",
+                   "AF_PYTHON=OFF")
+        try:
+            cmake_build(folder, targets, options, source=native.ROOT)
+            return folder / "tests", True
+        except subprocess.CalledProcessError:
+            if libfuzzer:
+                raise
+            shutil.rmtree(folder, ignore_errors=True)  # a configuration that failed is not kept
+            print("tests.fuzz.run: no clang with libFuzzer (Debian: clang libclang-rt-dev): the targets' own driver",
+                  file=sys.stderr)
+    return native.build(targets, sanitize=True) / "tests", False
 
 
 def run_libfuzzer(binary: Path, model: str, seconds: float, work: Path) -> Run:
@@ -90,8 +92,7 @@ def run_driver(binary: Path, model: str, seconds: float, seed: int = 1) -> Run:
 def fuzz(seconds: float, libfuzzer: bool | None = None) -> list[Run]:
     """Every model's target for seconds from its corpus: libFuzzer's where available (None: where clang
     has it), else the driver's."""
-    libfuzzer = libfuzzer_available() if libfuzzer is None else libfuzzer
-    folder = build(libfuzzer)
+    folder, libfuzzer = build(libfuzzer)
     with tempfile.TemporaryDirectory() as work:
         return [run_libfuzzer(folder / f"fuzz_state_{m}", m, seconds, Path(work)) if libfuzzer
                 else run_driver(folder / f"fuzz_state_{m}", m, seconds) for m in MODELS]
