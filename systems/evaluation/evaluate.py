@@ -9,7 +9,6 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from attitude_fmu.blocks.errors import quaternion_errors
 from attitude_fmu.blocks.pipeline.batch import check_options, estimate
@@ -17,7 +16,7 @@ from attitude_fmu.blocks.stages.delays import best_shift
 from attitude_fmu.blocks.stages.timing import carry_forward_rows, interval_ends, interval_means
 from attitude_fmu.systems.cluster.jobs import Failure, Jobs
 from attitude_fmu.systems.evaluation.alignment import align as align_reference
-from attitude_fmu.systems.evaluation.alignment import heading_offset, without_heading_offset
+from attitude_fmu.systems.evaluation.alignment import heading_offset, reference_rates, without_heading_offset
 from attitude_fmu.systems.evaluation.compare import peer_quaternions
 from attitude_fmu.systems.evaluation.groups import groups
 from attitude_fmu.systems.recordings.reading import read_recording
@@ -82,11 +81,7 @@ def imu_latency(rec: Recording) -> float | None:
     ±LATENCY_SEARCH_S (blocks.stages.delays.best_shift).
     None where the reference gives fewer than a second of rates or the best shift lies at
     the search's edge."""
-    ok = np.isfinite(rec.quat_ref).all(axis=1)
-    rot = Rotation.from_quat(np.where(ok[:, None], rec.quat_ref, [1.0, 0.0, 0.0, 0.0]), scalar_first=True)
-    rate = np.full(rec.gyr.shape, np.nan)  # rate[k]: the reference's mean rate over (t_k−1, t_k]
-    rate[1:] = (rot[:-1].inv() * rot[1:]).as_rotvec() * rec.fs
-    rate[~(ok & np.roll(ok, 1))] = np.nan
+    rate = reference_rates(rec.quat_ref, rec.fs)  # rate[k]: the reference's mean rate over (t_k−1, t_k]
     k = np.flatnonzero(np.isfinite(rate).all(axis=1) & (True if rec.movement is None else rec.movement))
     if len(k) < rec.fs:
         return None
