@@ -1,8 +1,8 @@
 // pipeline.cpp: the estimator's C core bound into attitude_fmu._core: parameter validation, the
 // methods' steppers, the causal pipeline (over arrays: the batch path; per sample: the online
-// estimator), the offline smoother and the quaternion array helpers. Arrays are C-contiguous
-// float64 (inputs converted where needed; outputs written in place, never converted). Every
-// refusal of the core is raised as ValueError with its message.
+// estimator), the offline smoother, the quaternion array helpers and the attitude error (errors.h).
+// Arrays are C-contiguous float64 (inputs converted where needed; outputs written in place, never
+// converted). Every refusal of the core is raised as ValueError with its message.
 #include <nanobind/nanobind.h>
 #include <nanobind/ndarray.h>
 #include <nanobind/stl/array.h>
@@ -21,6 +21,7 @@
 #include <vector>
 
 extern "C" {
+#include "errors.h"
 #include "filters/sensor_frame.h"
 #include "filters/tseng.h"
 #include "methods/registry.h"
@@ -297,6 +298,11 @@ void bind_pipeline(nb::module_ &m)
             return array_of(out, {3});
         },
         "gyr0"_a, "acc0"_a, "Ts"_a);
+    m.def(
+        "attitude_error",
+        [](Vec ghat, std::array<double, 4> q) { return attitude_error(ghat.data(), q.data()); }, "ghat"_a, "q"_a,
+        "The inclination error (rad) between ghat (m/s^2, sensor coordinates) and the true up of q (sensor -> "
+        "earth, [w, x, y, z]).");
     m.def(
         "integrate_rates",
         [](Rows3 gyr, double Ts, Out4 quat) {

@@ -78,13 +78,14 @@ static const struct {
             {7, 9.504178996162932e-1, PADE7}, {9, 2.097847961257068e0, PADE9},
             {13, 5.371920351148152e0, PADE13}};
 
-void expm(int n, const double *M, double *E)
+void expm_work(int n, const double *M, double *E, double *work)
 {
-    double A[MATRIX_MAX * MATRIX_MAX], power[5][MATRIX_MAX * MATRIX_MAX]; /* A^0, A^2, ... A^8 */
-    double U[MATRIX_MAX * MATRIX_MAX], V[MATRIX_MAX * MATRIX_MAX], T[MATRIX_MAX * MATRIX_MAX];
+    const int nn = n * n;
+    double *A = work, *power[5], *U = work + 6 * nn, *V = work + 7 * nn, *T = work + 8 * nn; /* A^0, A^2, ... A^8 */
     double norm = norm1(n, M);
-    int nn = n * n, choice = 0, squarings = 0, top, i, k;
+    int choice = 0, squarings = 0, top, i, k;
     const double *b;
+    for (k = 0; k < 5; k++) power[k] = work + (1 + k) * nn;
     while (choice < 4 && norm > PADE[choice].theta) choice++;
     if (choice == 4 && norm > PADE[4].theta) squarings = (int)ceil(log2(norm / PADE[4].theta));
     for (i = 0; i < nn; i++) A[i] = ldexp(M[i], -squarings);
@@ -93,8 +94,7 @@ void expm(int n, const double *M, double *E)
     multiply(n, A, A, power[1]);
     top = PADE[choice].degree == 13 ? 3 : (PADE[choice].degree - 1) / 2; /* the even powers needed */
     for (k = 2; k <= top; k++) multiply(n, power[k - 1], power[1], power[k]);
-    memset(U, 0, sizeof U);
-    memset(V, 0, sizeof V);
+    for (i = 0; i < nn; i++) U[i] = V[i] = 0.0;
     if (PADE[choice].degree < 13) {
         /* U = A sum b_{2k+1} A^2k, V = sum b_2k A^2k */
         for (k = 0; k <= top; k++)
@@ -102,13 +102,13 @@ void expm(int n, const double *M, double *E)
                 U[i] += b[2 * k + 1] * power[k][i];
                 V[i] += b[2 * k] * power[k][i];
             }
-        memcpy(T, U, sizeof T);
+        memcpy(T, U, sizeof(double) * nn);
         multiply(n, A, T, U);
     } else {
         /* degree 13 from A^2, A^4, A^6 (Higham 2005, eq. 2.7):
          * U = A (A^6 (b13 A^6 + b11 A^4 + b9 A^2) + b7 A^6 + b5 A^4 + b3 A^2 + b1 I),
          * V = A^6 (b12 A^6 + b10 A^4 + b8 A^2) + b6 A^6 + b4 A^4 + b2 A^2 + b0 I */
-        double W[MATRIX_MAX * MATRIX_MAX] = {0.0}, Z[MATRIX_MAX * MATRIX_MAX] = {0.0};
+        double *W = work + 9 * nn, *Z = work + 10 * nn;
         for (i = 0; i < nn; i++) {
             W[i] = b[13] * power[3][i] + b[11] * power[2][i] + b[9] * power[1][i];
             Z[i] = b[12] * power[3][i] + b[10] * power[2][i] + b[8] * power[1][i];
@@ -130,5 +130,22 @@ void expm(int n, const double *M, double *E)
     for (k = 0; k < squarings; k++) {
         memcpy(T, E, sizeof(double) * nn);
         multiply(n, T, T, E);
+    }
+}
+
+void zero_order_hold(int n, int m, const double *A, const double *B, double h, double *Ad, double *Bd, double *work)
+{
+    const int s = n + m;
+    double *M = work, *E = work + s * s;
+    int i, j;
+    for (i = 0; i < s * s; i++) M[i] = 0.0;
+    for (i = 0; i < n; i++) {
+        for (j = 0; j < n; j++) M[i * s + j] = h * A[i * n + j];
+        for (j = 0; j < m; j++) M[i * s + n + j] = h * B[i * m + j];
+    }
+    expm_work(s, M, E, work + 2 * s * s);
+    for (i = 0; i < n; i++) {
+        for (j = 0; j < n; j++) Ad[i * n + j] = E[i * s + j];
+        for (j = 0; j < m; j++) Bd[i * m + j] = E[i * s + n + j];
     }
 }

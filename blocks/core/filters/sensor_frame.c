@@ -10,23 +10,14 @@
 
 int discrete_filter(const EarthFilter *f, double Ts, DiscreteFilter *out, char *message, size_t size)
 {
-    double M[MATRIX_MAX * MATRIX_MAX] = {0.0}, E[MATRIX_MAX * MATRIX_MAX];
+    double work[ZERO_ORDER_HOLD_WORK(MAX_ORDER, 1)];
     char text[FLOAT_REPR_SIZE];
-    int n = f->n, m = f->n + 1, i, j;
     if (!(isfinite(Ts) && Ts > 0))
         return refuse(message, size, "sample time Ts must be a finite positive number of seconds, got %s",
                       float_repr(Ts, text));
-    for (i = 0; i < n; i++) {
-        for (j = 0; j < n; j++) M[i * m + j] = Ts * f->A[i * n + j];
-        M[i * m + n] = Ts * f->B[i];
-    }
-    expm(m, M, E);
-    out->n = n;
-    for (i = 0; i < n; i++) {
-        for (j = 0; j < n; j++) out->Ad[i * n + j] = E[i * m + j];
-        out->Bd[i] = E[i * m + n];
-        out->C[i] = f->C[i];
-    }
+    zero_order_hold(f->n, 1, f->A, f->B, Ts, out->Ad, out->Bd, work);
+    out->n = f->n;
+    for (int i = 0; i < f->n; i++) out->C[i] = f->C[i];
     out->D = f->D;
     out->Ts = Ts;
     return 0;

@@ -38,6 +38,7 @@ void mahony_initial_state(const MahonyCoef *coef, const double acc0[3], MahonySt
 Quat level_on(const double acc0[3])
 {
     double norm = sqrt(acc0[0] * acc0[0] + acc0[1] * acc0[1] + acc0[2] * acc0[2]);
+    if (norm == 0.0) return (Quat){1.0, 0.0, 0.0, 0.0}; /* no reading to level on (free fall): level */
     double u0 = acc0[0] / norm, u1 = acc0[1] / norm, u2 = acc0[2] / norm;
     double w = 1.0 + u2, qn;
     if (w < 1e-12) return (Quat){0.0, 1.0, 0.0, 0.0};

@@ -39,7 +39,8 @@ int mahony_coefficients(const double params[AF_N_PARAMS], double Ts, MahonyCoef 
 /* Level on acc0 (heading 0), no bias. */
 void mahony_initial_state(const MahonyCoef *coef, const double acc0[3], MahonyState *state);
 
-/* The quaternion (sensor -> earth) of the smallest rotation taking acc0 onto up. */
+/* The quaternion (sensor -> earth) of the smallest rotation taking acc0 onto up; the identity where acc0
+ * is 0 (free fall, or python-control's first pass over a diagram: nothing to level on). */
 Quat level_on(const double acc0[3]);
 
 /* One sample of the filter on state in place; returns the unit up estimate. */

@@ -225,6 +225,20 @@ void stepper_state_names(const AfStepper *s, char names[][STATE_NAME_SIZE])
         snprintf(names[k++], STATE_NAME_SIZE, "%s", *name);
 }
 
+int stepper_state_valid(const AfStepper *s, const double *state)
+{
+    char names[AF_STEPPER_STATE_MAX][STATE_NAME_SIZE];
+    if (s->state_size < 0 || s->state_size > AF_STEPPER_STATE_MAX || !finite_values(state, s->state_size)) return 0;
+    stepper_state_names(s, names);
+    for (int k = 0; k + 3 < s->state_size; k++)
+        if (strcmp(names[k], "q_w") == 0) {
+            double n2 = state[k] * state[k] + state[k + 1] * state[k + 1] + state[k + 2] * state[k + 2] +
+                        state[k + 3] * state[k + 3];
+            return fabs(n2 - 1.0) < 1e-6;
+        }
+    return 1;
+}
+
 /* The stepper's state array as the kernel's state struct (the array is of doubles, as the struct's members) */
 #define STATE(type, state) ((type *)(void *)(state))
 

@@ -96,6 +96,10 @@ int stepper_of_filter(AfStepper *s, const DiscreteFilter *d, char *message, size
  * STATE_NAME_SIZE bytes): x0_x, x0_y, ..., q_w, ... of a sensor-frame filter, a kernel's own. */
 void stepper_state_names(const AfStepper *s, char names[][STATE_NAME_SIZE]);
 
+/* Whether state (s->state_size doubles; s a stepper the core made) is one the stepper can run on:
+ * finite, its quaternion (q_w ... q_z, where it has one) a unit one to 1e-6. */
+int stepper_state_valid(const AfStepper *s, const double *state);
+
 /* initial_state(gravity): at rest on gravity (m/s^2, sensor coordinates; e.g. start_gravity
  * of the first sample), into state (s->state_size values). */
 void stepper_initial_state(const AfStepper *s, const double gravity[3], double *state);

@@ -95,21 +95,6 @@ static int all_finite(const double *values, size_t n)
     return 1;
 }
 
-/* whether the stepper's state (its state_size doubles) is finite, its quaternion (q_w ... q_z) a unit one */
-static int stepper_state_valid(const AfStepper *s, const double *state)
-{
-    char names[AF_STEPPER_STATE_MAX][STATE_NAME_SIZE];
-    if (!all_finite(state, AF_STEPPER_STATE_MAX)) return 0;
-    stepper_state_names(s, names);
-    for (int k = 0; k + 3 < s->state_size; k++)
-        if (strcmp(names[k], "q_w") == 0) {
-            double n2 = state[k] * state[k] + state[k + 1] * state[k + 1] + state[k + 2] * state[k + 2] +
-                        state[k + 3] * state[k + 3];
-            return fabs(n2 - 1.0) < 1e-6;
-        }
-    return 1;
-}
-
 /* whether two discrete filters are the same: order, the entries of that order, D and Ts, bit for bit */
 static int same_filter(const DiscreteFilter *a, const DiscreteFilter *b)
 {
@@ -186,8 +171,8 @@ int af_online_validate(const AfOnline *est, const AfOnline *configured, char *me
     if (!all_finite(state->last_gyr, 3) || !af_finite(&state->offset, sizeof state->offset, NULL) ||
         !af_finite(&state->heading, sizeof state->heading, NULL))
         return refuse(message, size, "the estimator's stages hold values that are not finite");
-    if (state->started ? !stepper_state_valid(&est->step.stepper, state->method)
-                       : !all_finite(state->method, AF_STEPPER_STATE_MAX))
+    if (!all_finite(state->method, AF_STEPPER_STATE_MAX) ||
+        (state->started && !stepper_state_valid(&est->step.stepper, state->method)))
         return refuse(message, size, "the estimator's method holds values that are not finite or no unit quaternion");
     if (!all_finite(est->quat, 4) || !all_finite(est->up, 3) || !all_finite(est->euler, 3) ||
         !all_finite(est->offset, 3) || !all_finite(est->mag_offset, 3) || !isfinite(est->mag_delay))

@@ -21,6 +21,18 @@ int imu_refuse_vector(const char *name, const char *repr, char *message, size_t 
     return refuse(message, size, "%s must be %s finite numbers, got %s", name, shape, repr);
 }
 
+int imu_from_vector(const double v[IMU_VECTOR_SIZE], ImuParams *p, char *message, size_t size) {
+    p->delta_n = v[0];
+    memcpy(p->gyr_offset, v + 1, sizeof p->gyr_offset);
+    memcpy(p->gyr_scale, v + 4, sizeof p->gyr_scale);
+    p->acc_noise = v[13];
+    memcpy(p->acc_offset, v + 14, sizeof p->acc_offset);
+    p->latency = v[17];
+    p->mag_noise = v[18];
+    memcpy(p->mag_offset, v + 19, sizeof p->mag_offset);
+    return imu_check(p, message, size);
+}
+
 int imu_check(const ImuParams *p, char *message, size_t size) {
     const char *names[4] = {"delta_n", "acc_noise", "latency", "mag_noise"};
     const double values[4] = {p->delta_n, p->acc_noise, p->latency, p->mag_noise};

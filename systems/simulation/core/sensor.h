@@ -15,6 +15,13 @@ typedef struct {
     double delta_n, gyr_offset[3], gyr_scale[9], acc_noise, acc_offset[3], latency, mag_noise, mag_offset[3];
 } ImuParams;
 
+#define IMU_VECTOR_SIZE 22 /* ImuModel.vector's numbers */
+
+/* The parameters of ImuModel.vector v, in ImuParams' order: delta_n, gyr_offset (3), gyr_scale (9,
+ * row-major), acc_noise, acc_offset (3), latency, mag_noise, mag_offset (3); checked (imu_check): 0, or
+ * -1 with the message. */
+int imu_from_vector(const double v[IMU_VECTOR_SIZE], ImuParams *p, char *message, size_t size);
+
 /* ImuModel's refusals: 0, or -1 with the message. */
 int imu_check(const ImuParams *p, char *message, size_t size);
 /* the refusal of a vector parameter (gyr_offset, acc_offset, mag_offset: 3 numbers; gyr_scale: 3x3)

@@ -102,25 +102,14 @@ nb::tuple stream_step(HumanStream &s, double start, double end)
     return nb::make_tuple(gyr, f, quat);
 }
 
-// ImuModel's fields as ImuModel.vector gives them, in ImuParams' order: delta_n, gyr_offset (3),
-// gyr_scale (9, row-major), acc_noise, acc_offset (3), latency, mag_noise, mag_offset (3); checked
-constexpr size_t IMU_N_PARAMS = 22;
-using ImuVector = In<IMU_N_PARAMS>;
+// ImuModel.vector (sensor.h, imu_from_vector), checked
+using ImuVector = In<IMU_VECTOR_SIZE>;
 
 ImuParams imu_params(const ImuVector &v)
 {
-    const double *x = v.data();
     ImuParams p;
-    p.delta_n = x[0];
-    std::memcpy(p.gyr_offset, x + 1, sizeof p.gyr_offset);
-    std::memcpy(p.gyr_scale, x + 4, sizeof p.gyr_scale);
-    p.acc_noise = x[13];
-    std::memcpy(p.acc_offset, x + 14, sizeof p.acc_offset);
-    p.latency = x[17];
-    p.mag_noise = x[18];
-    std::memcpy(p.mag_offset, x + 19, sizeof p.mag_offset);
     char message[MESSAGE_SIZE];
-    raise_if(imu_check(&p, message, sizeof message), message);
+    raise_if(imu_from_vector(v.data(), &p, message, sizeof message), message);
     return p;
 }
 
@@ -286,7 +275,7 @@ void bind_earth_field(nb::module_ &m)
 
 void bind_sensor(nb::module_ &m)
 {
-    m.attr("IMU_N_PARAMS") = IMU_N_PARAMS;
+    m.attr("IMU_N_PARAMS") = IMU_VECTOR_SIZE;
     m.def("imu_check", [](ImuVector params) { imu_params(params); }, nb::arg("params"),
           "ImuModel's refusals (params: ImuModel.vector): ValueError with the reason.");
     m.def(
