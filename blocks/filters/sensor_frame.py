@@ -17,18 +17,20 @@ python-control block, the batch path and the FMU share.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from attitude_fmu import _core
-from attitude_fmu.blocks.control_system import sample_system
+from attitude_fmu.blocks.control_system import CStep, resting, sample_system, with_c_step
+from attitude_fmu.blocks.tuning import STANDARD_GRAVITY
 
 AXES = ("x", "y", "z")
 INPUTS = [f"{s}_{a}" for s in ("gyr", "acc") for a in AXES]  # of every estimator block: rad/s, m/s²
 OUTPUTS = [f"ghat_{a}" for a in AXES] + ["q_w", "q_x", "q_y", "q_z"]  # m/s²; sensor → earth
 GRAVITY_OUTPUTS = OUTPUTS[:3]
 QUAT_NAMES = OUTPUTS[3:]
+REST_INPUTS = (0.0, 0.0, 0.0, 0.0, 0.0, STANDARD_GRAVITY)  # an estimator's natural rest: gyro 0, acc g·ẑ
 
 
 @dataclass(frozen=True)
@@ -86,18 +88,30 @@ def state_names(order: int) -> list[str]:
     return [f"x{j}_{a}" for j in range(order) for a in AXES]
 
 
-def stepper_system(stepper: _core.Stepper, dt: float, name: str = "estimator"):
+def stepper_system(stepper: _core.Stepper, dt: float, name: str = "estimator", step: CStep | None = None):
     """Inputs gyr_x..z (rad/s), acc_x..z (m/s²); outputs ghat_x..z (m/s²) and q_w..q_z,
     equal to the batch path's estimate at k. x0: stepper.initial_state(gravity), or
     python-control's default zero state, with which the block starts at rest on its first
-    sample as the batch path does (start_gravity)."""
+    sample as the batch path does (start_gravity). step: the C step it is marked with
+    (with_c_step; its start, rest and natural rest filled in here), None: unmarked."""
     def advance(state, u):
         gravity, quat = np.empty((1, 3)), np.empty((1, 4))
         stepper.run(state, u[0:3].reshape(1, 3), u[3:6].reshape(1, 3), gravity, quat)
         return state, np.concatenate([gravity[0], quat[0]])
 
-    return sample_system(advance, INPUTS, OUTPUTS, stepper.state_names, dt, name,
-                         start=lambda u: stepper.initial_state(start_gravity(u[0:3], u[3:6], dt)))
+    def start(u):
+        return stepper.initial_state(start_gravity(u[0:3], u[3:6], dt))
+
+    def run(state, rows):
+        n = len(rows)
+        stepper.run(state, np.ascontiguousarray(rows[:, 0:3]), np.ascontiguousarray(rows[:, 3:6]), np.empty((n, 3)),
+                    np.empty((n, 4)))
+
+    system = sample_system(advance, INPUTS, OUTPUTS, stepper.state_names, dt, name, start=start)
+    if step is None:
+        return system
+    return with_c_step(system, replace(step, start=True, rest=lambda u: resting(run, start(u), u, dt),
+                                       rest_inputs=REST_INPUTS))
 
 
 def sensor_frame_system(earth_filter, dt: float | None = None, name: str = "estimator"):
@@ -107,11 +121,14 @@ def sensor_frame_system(earth_filter, dt: float | None = None, name: str = "esti
     dt None: continuous time, states X (row by row). dt > 0: discrete time with the
     C core's step; states X then q_w..q_z, outputs also q_w..q_z. A discrete system's
     output at k is taken after the update with the inputs at k, so it equals the batch
-    path's estimate at k; x0 should come from `initial_state`.
+    path's estimate at k; x0 should come from `initial_state`. The discrete system is marked
+    with its C step, "filter" (numbers [n, Ad, Bd, C, D]).
     """
     if dt is None:
         return _continuous_system(_siso_state_space(earth_filter), name)
-    return stepper_system(DiscreteFilter.from_lti(earth_filter, dt).stepper(), dt, name)
+    disc = DiscreteFilter.from_lti(earth_filter, dt)
+    numbers = (disc.order, *disc.Ad.ravel(), *disc.Bd, *disc.C, disc.D)
+    return stepper_system(disc.stepper(), dt, name, CStep("filter", dt, numbers=tuple(map(float, numbers))))
 
 
 def time_reversed(gyr) -> np.ndarray:

@@ -18,6 +18,7 @@ from typing import Callable, Mapping
 
 from attitude_fmu import _core
 from attitude_fmu.blocks import tuning
+from attitude_fmu.blocks.control_system import CStep, given
 from attitude_fmu.blocks.filters import earth_filters as ef
 from attitude_fmu.blocks.filters import tseng
 from attitude_fmu.blocks.filters.sensor_frame import DiscreteFilter, stepper_system
@@ -128,5 +129,7 @@ def estimator_system(method: str = "wiener", params: Mapping[str, float] | None 
     sample time dt (s), named name: inputs gyr_x..z (rad/s), acc_x..z (m/s²), outputs
     ghat_x..z (m/s²) and q_w..q_z, the batch path's estimate at each sample
     (blocks.filters.sensor_frame.stepper_system; its state is the C step's state array; from
-    the zero initial state it starts at rest on its first sample)."""
-    return stepper_system(stepper(method, tuple(sorted((params or {}).items())), dt), dt, name)
+    the zero initial state it starts at rest on its first sample). Marked with its C step,
+    "method" (the params given, as given)."""
+    return stepper_system(stepper(method, tuple(sorted((params or {}).items())), dt), dt, name,
+                          CStep("method", dt, method, **given(params)))

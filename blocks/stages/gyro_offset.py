@@ -42,8 +42,8 @@ from __future__ import annotations
 import numpy as np
 
 from attitude_fmu import _core
-from attitude_fmu.blocks.control_system import sample_system
-from attitude_fmu.blocks.filters.sensor_frame import time_reversed
+from attitude_fmu.blocks.control_system import CStep, given, resting, sample_system, with_c_step
+from attitude_fmu.blocks.filters.sensor_frame import REST_INPUTS, time_reversed
 
 STATE_NAMES = _core.GYRO_OFFSET_STATE_NAMES  # the state vector's entries: the C core's struct AfGyroOffset
 
@@ -71,7 +71,8 @@ def offset_system(dt: float, params=None, name: str = "gyro_offset"):
     """Discrete python-control system of the estimator: inputs gyr_raw_x..z (rad/s, the
     measured gyro) and acc_x..z (m/s²); outputs gyr_x..z, the gyro less the offset
     estimate after the sample (rad/s), and offset_x..z. x0: initial_state, or the zero
-    state, with which it starts at rest on its first sample."""
+    state, with which it starts at rest on its first sample. Marked with its C step,
+    "gyro_offset" (the params given, as given)."""
     coef = coefficients(resolve(params), dt)
 
     def advance(state, u):
@@ -79,9 +80,17 @@ def offset_system(dt: float, params=None, name: str = "gyro_offset"):
         _core.gyro_offset_run(state, coef, u[0:3].reshape(1, 3), u[3:6].reshape(1, 3), offset, variance)
         return state, np.concatenate([u[0:3] - offset[0], offset[0]])
 
-    return sample_system(advance, [f"{s}_{a}" for s in ("gyr_raw", "acc") for a in "xyz"],
-                         [f"{s}_{a}" for s in ("gyr", "offset") for a in "xyz"], STATE_NAMES, dt, name,
-                         start=lambda u: initial_state(coef, u[0:3], u[3:6]))
+    def start(u):
+        return initial_state(coef, u[0:3], u[3:6])
+
+    def run(state, rows):
+        _core.gyro_offset_run(state, coef, np.ascontiguousarray(rows[:, 0:3]), np.ascontiguousarray(rows[:, 3:6]),
+                              np.empty((len(rows), 3)), np.empty((len(rows), 3)))
+
+    system = sample_system(advance, [f"{s}_{a}" for s in ("gyr_raw", "acc") for a in "xyz"],
+                           [f"{s}_{a}" for s in ("gyr", "offset") for a in "xyz"], STATE_NAMES, dt, name, start=start)
+    return with_c_step(system, CStep("gyro_offset", dt, **given(params), start=True,
+                                     rest=lambda u: resting(run, start(u), u, dt), rest_inputs=REST_INPUTS))
 
 
 def correct(gyr, acc, fs: float, params=None, offline: bool = False):

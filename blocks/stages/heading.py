@@ -39,9 +39,10 @@ from __future__ import annotations
 import numpy as np
 
 from attitude_fmu import _core
-from attitude_fmu.blocks.control_system import sample_system
+from attitude_fmu.blocks.control_system import CStep, given, resting, sample_system, with_c_step
 
 STATE_NAMES = _core.HEADING_STATE_NAMES  # the state vector's entries: the C core's struct AfHeading
+REST_INPUTS = (1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0)  # the stage's natural rest: q the identity, a field north (µT)
 
 
 def resolve(overrides=None) -> dict:
@@ -66,7 +67,8 @@ def heading_system(dt: float, params=None, name: str = "heading"):
     """Discrete python-control system of the heading stage: inputs q_w..z (the attitude
     filter's orientation) and mag_x..z (µT); outputs qh_w..z, the orientation with
     magnetometer heading, and mag_offset_x..z, the hard-iron estimate. x0: initial_state(),
-    or the zero state, which stands for it."""
+    or the zero state, which stands for it. Marked with its C step, "heading" (the params
+    given, as given)."""
     coef = coefficients(resolve(params), dt)
 
     def advance(state, u):
@@ -75,9 +77,16 @@ def heading_system(dt: float, params=None, name: str = "heading"):
                           offset, np.empty(1))
         return state, np.concatenate([out[0], offset[0]])
 
-    return sample_system(advance, [f"q_{c}" for c in "wxyz"] + [f"mag_{c}" for c in "xyz"],
-                         [f"qh_{c}" for c in "wxyz"] + [f"mag_offset_{c}" for c in "xyz"],
-                         STATE_NAMES, dt, name, start=lambda u: initial_state())
+    def run(state, rows):
+        n = len(rows)
+        _core.heading_run(state, coef, np.ascontiguousarray(rows[:, 0:4]), np.ascontiguousarray(rows[:, 4:7]),
+                          np.empty((n, 4)), np.empty(n, dtype=np.bool_), np.empty((n, 3)), np.empty(n))
+
+    system = sample_system(advance, [f"q_{c}" for c in "wxyz"] + [f"mag_{c}" for c in "xyz"],
+                           [f"qh_{c}" for c in "wxyz"] + [f"mag_offset_{c}" for c in "xyz"],
+                           STATE_NAMES, dt, name, start=lambda u: initial_state())
+    return with_c_step(system, CStep("heading", dt, **given(params), start=True,
+                                     rest=lambda u: resting(run, initial_state(), u, dt), rest_inputs=REST_INPUTS))
 
 
 def with_magnetometer(quat, mag, fs: float, params=None):

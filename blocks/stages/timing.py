@@ -28,7 +28,8 @@ from __future__ import annotations
 import numpy as np
 
 from attitude_fmu import _core
-from attitude_fmu.blocks.control_system import sample_system
+from attitude_fmu.blocks.control_system import CStep, sample_system, with_c_step
+from attitude_fmu.blocks.tuning import STANDARD_GRAVITY
 
 # the core's values: the relative difference below which two sample times are one (a master that
 # keeps time in integer nanoseconds, or sums steps in floating point, hands over Ts with rounding
@@ -81,7 +82,7 @@ def interval_ends(gyr, acc, Ts: float) -> np.ndarray:
 def latency_system(dt: float, latency: float, quat_inputs=("q_w", "q_x", "q_y", "q_z"), name: str = "latency"):
     """Static python-control block: inputs gyr_x..z (rad/s), the orientation (quat_inputs)
     and ghat_x..z (m/s²); outputs ql_w..z and ghatl_x..z, both carried forward over
-    latency (s)."""
+    latency (s). Marked with its C step, "latency" (numbers [latency])."""
     latency = check_latency(latency)
 
     def advance(state, u):
@@ -89,5 +90,7 @@ def latency_system(dt: float, latency: float, quat_inputs=("q_w", "q_x", "q_y", 
         _core.carry_forward_rows(quat, gravity, u[0:3].reshape(1, 3), latency)
         return state, np.concatenate([quat[0], gravity[0]])
 
-    return sample_system(advance, [f"gyr_{a}" for a in "xyz"] + list(quat_inputs) + [f"ghat_{a}" for a in "xyz"],
-                         [f"ql_{c}" for c in "wxyz"] + [f"ghatl_{a}" for a in "xyz"], [], dt, name)
+    system = sample_system(advance, [f"gyr_{a}" for a in "xyz"] + list(quat_inputs) + [f"ghat_{a}" for a in "xyz"],
+                           [f"ql_{c}" for c in "wxyz"] + [f"ghatl_{a}" for a in "xyz"], [], dt, name)
+    return with_c_step(system, CStep("latency", dt, numbers=(latency,),
+                                     rest_inputs=(0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, STANDARD_GRAVITY)))

@@ -5,7 +5,8 @@ from __future__ import annotations
 import control
 import numpy as np
 
-from attitude_fmu.blocks.errors import inclination_error
+from attitude_fmu import _core
+from attitude_fmu.blocks.control_system import CStep, with_c_step
 from attitude_fmu.blocks.filters.sensor_frame import GRAVITY_OUTPUTS, QUAT_NAMES
 from attitude_fmu.blocks.methods.registry import estimator_system, stepper
 from attitude_fmu.blocks.pipeline.causal import split_params
@@ -13,6 +14,7 @@ from attitude_fmu.blocks.stages import gyro_offset as offset_stage
 from attitude_fmu.blocks.stages.heading import heading_system
 from attitude_fmu.blocks.stages.heading import initial_state as heading_initial_state
 from attitude_fmu.blocks.stages.timing import latency_system
+from attitude_fmu.blocks.tuning import STANDARD_GRAVITY
 from attitude_fmu.systems.simulation.motion import AXES, HumanMotion, earth_field
 from attitude_fmu.systems.simulation.noise import MAGNETOMETER, MOTION, SENSOR, normals
 from attitude_fmu.systems.simulation.sensor_model import ImuModel
@@ -22,27 +24,28 @@ MAG_NOISE_INPUTS = [f"nm_{a}" for a in AXES]  # the magnetometer's, with the hea
 
 
 def attitude_error_system(fs: float, name: str = "error"):
-    """Static block: inclination error (rad) between ghat_* and the true up of qt_*."""
+    """Static block: inclination error incl_err (rad) between ghat_* (m/s²) and the true up of
+    qt_* (sensor → earth), the C core's (blocks/core/errors.h). Marked with its C step, "error"."""
     def output(t, x, u, params):
-        q = u[3:7]
-        # true up in sensor coordinates: third row of R(q)
-        up = [2 * (q[1] * q[3] - q[0] * q[2]), 2 * (q[2] * q[3] + q[0] * q[1]),
-              1 - 2 * (q[1] ** 2 + q[2] ** 2)]
-        return [float(inclination_error(u[0:3], up))]
+        return [_core.attitude_error(u[0:3], u[3:7])]
 
-    return control.nlsys(None, output, inputs=GRAVITY_OUTPUTS + ["qt_w", "qt_x", "qt_y", "qt_z"],
-                         outputs=["incl_err"], dt=1.0 / fs, name=name)
+    system = control.nlsys(None, output, inputs=GRAVITY_OUTPUTS + ["qt_w", "qt_x", "qt_y", "qt_z"],
+                           outputs=["incl_err"], dt=1.0 / fs, name=name)
+    return with_c_step(system, CStep("error", 1.0 / fs, rest_inputs=(0.0, 0.0, STANDARD_GRAVITY, 1.0, 0.0, 0.0, 0.0)))
 
 
 def magnetometer_system(imu: ImuModel, fs: float, name: str = "magnetometer"):
     """Static block: the field mag_* (µT, sensor coordinates) the magnetometer of imu
     measures (ImuModel.measure_mag, unit-normal noise nm_*) at the orientation qt_*
-    (systems.simulation.motion.earth_field, as Motion.mag)."""
+    (systems.simulation.motion.earth_field, as Motion.mag). Marked with its C step,
+    "magnetometer" (numbers: imu.vector)."""
     def output(t, x, u, params):
         return imu.measure_mag(earth_field(u[0:4]), u[4:7], fs)
 
-    return control.nlsys(None, output, inputs=["qt_w", "qt_x", "qt_y", "qt_z", *MAG_NOISE_INPUTS],
-                         outputs=[f"mag_{a}" for a in AXES], dt=1.0 / fs, name=name)
+    system = control.nlsys(None, output, inputs=["qt_w", "qt_x", "qt_y", "qt_z", *MAG_NOISE_INPUTS],
+                           outputs=[f"mag_{a}" for a in AXES], dt=1.0 / fs, name=name)
+    return with_c_step(system, CStep("magnetometer", 1.0 / fs, numbers=(*imu.vector, float(fs)),
+                                     rest_inputs=(1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)))
 
 
 def closed_loop(motion: HumanMotion, imu: ImuModel, fs: float, method: str = "wiener",
@@ -51,8 +54,9 @@ def closed_loop(motion: HumanMotion, imu: ImuModel, fs: float, method: str = "wi
     params: as blocks.pipeline.causal.split_params, for the method and the stages below.
 
     gyro_offset (default on, as everywhere): the gyro-offset estimator
-    (blocks.stages.gyro_offset, its low-passes at rest on g·ẑ) between sensor and estimator; heading: the heading stage (blocks.stages.heading) on the
-    estimator's orientation and the magnetometer. Inputs: NOISE_INPUTS (unit-normal
+    (blocks.stages.gyro_offset, its low-passes at rest on g·ẑ) between sensor and estimator;
+    heading: the heading stage (blocks.stages.heading) on the estimator's orientation and the
+    magnetometer. Inputs: NOISE_INPUTS (unit-normal
     samples; with heading also MAG_NOISE_INPUTS); outputs: incl_err (rad), ghat_*, q_*,
     with gyro_offset the gyro offset estimate offset_* (rad/s), with heading qh_* and the
     hard-iron estimate mag_offset_* (µT);

@@ -13,7 +13,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from attitude_fmu import _core
-from attitude_fmu.blocks.control_system import sample_system
+from attitude_fmu.blocks.control_system import CStep, sample_system, with_c_step
 from attitude_fmu.blocks.tuning import STANDARD_GRAVITY
 from attitude_fmu.systems.simulation import profile_table
 from attitude_fmu.systems.simulation.noise import MOTION, normals
@@ -111,7 +111,8 @@ class HumanMotion:
     def system(self, fs: float, name: str = "motion"):
         """Discrete python-control system: inputs eps_v_x..z, eps_w_x..z (unit normal
         noise per sample); states v (m/s), omega (rad/s), q; outputs TRUTH_OUTPUTS. A cell
-        per sample: grid None (or 1/fs)."""
+        per sample: grid None (or 1/fs). Marked with its C step, "human" (numbers:
+        coefficients(fs)); at rest (no noise): initial_state()."""
         if self.grid is not None and self.grid != 1.0 / fs:
             raise ValueError(f"the system takes a grid cell per sample: grid {self.grid!r} s at fs {fs!r} Hz")
         coef = self.coefficients(fs)
@@ -121,9 +122,11 @@ class HumanMotion:
             _core.human_run(state, np.ascontiguousarray(u, dtype=float).reshape(1, 6), coef, out)
             return state, out[0]
 
-        return sample_system(
+        system = sample_system(
             advance, [f"eps_{s}_{a}" for s in "vw" for a in AXES], TRUTH_OUTPUTS,
             [f"v_{a}" for a in AXES] + [f"w_{a}" for a in AXES] + ["qm_w", "qm_x", "qm_y", "qm_z"], coef[4], name)
+        return with_c_step(system, CStep("human", coef[4], numbers=tuple(map(float, coef)),
+                                         rest=lambda u: self.initial_state()))
 
     @staticmethod
     def initial_state() -> np.ndarray:
@@ -165,6 +168,21 @@ class ClosedForm:
         t = np.arange(1, int(round(duration * fs)) + 1) / fs
         gyr, acc, quat = self.at(t, 1.0 / fs)
         return Motion(fs, quat, gyr, acc)
+
+    def system(self, fs: float, name: str = "motion"):
+        """Discrete python-control system of sample rate fs (Hz), no inputs: outputs
+        TRUTH_OUTPUTS at sample k those of the interval ending at (k + 1)/fs, as generate()
+        samples them; state k, the samples taken (x0: 0). Marked with its C step,
+        "closed_form" (the profile's name; numbers its params, then g)."""
+        h = 1.0 / fs
+
+        def advance(state, u):
+            gyr, acc, quat = self.at((state[0] + 1.0) * h, h)
+            return state + 1.0, np.concatenate([gyr[0], acc[0], quat[0]])
+
+        system = sample_system(advance, [], TRUTH_OUTPUTS, ["k"], h, name)
+        return with_c_step(system, CStep("closed_form", h, self.name,
+                                         numbers=tuple(float(p) for p in (*self.params, self.g))))
 
     def stream(self, seed: int = 0) -> "ClosedForm":
         """Sample by sample: step(t, h) gives the interval (t − h, t], as generate() does."""

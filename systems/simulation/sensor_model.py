@@ -8,6 +8,8 @@ import control
 import numpy as np
 
 from attitude_fmu import _core
+from attitude_fmu.blocks.control_system import CStep, with_c_step
+from attitude_fmu.blocks.tuning import STANDARD_GRAVITY
 from attitude_fmu.systems.simulation.motion import AXES, Motion
 from attitude_fmu.systems.simulation.noise import MAGNETOMETER, SENSOR, normals
 
@@ -108,7 +110,8 @@ class ImuModel:
 
     def system(self, fs: float, name: str = "imu"):
         """Discrete python-control system: inputs omega_*, f_*, n_*, na_* (unit normal);
-        outputs gyr_*, acc_*; with a latency, states the delay line's (x0: delay_state)."""
+        outputs gyr_*, acc_*; with a latency, states the delay line's (x0: delay_state).
+        Marked with its C step, "imu" (numbers: vector); at rest on ω = 0, f = g·ẑ, no noise."""
         def output(t, x, u, params):
             signals = self.delay_step(x, u[0:6], fs)[1] if self.latency else u[0:6]
             gyr, acc = self.measure(signals[0:3], signals[3:6], u[6:12], fs)
@@ -116,8 +119,11 @@ class ImuModel:
 
         update = (lambda t, x, u, params: self.delay_step(x, u[0:6], fs)[0]) if self.latency else None
         states = len(self.delay_state(fs, np.zeros(6))) if self.latency else None
-        return control.nlsys(
+        system = control.nlsys(
             update, output, name=name, dt=1.0 / fs, states=states,
             inputs=[f"{s}_{a}" for s in ("omega", "f", "n", "na") for a in AXES],
             outputs=[f"gyr_{a}" for a in AXES] + [f"acc_{a}" for a in AXES],
         )
+        return with_c_step(system, CStep("imu", 1.0 / fs, numbers=(*self.vector, float(fs)),
+                                         rest=(lambda u: self.delay_state(fs, u[0:6])) if self.latency else None,
+                                         rest_inputs=(0.0,) * 5 + (STANDARD_GRAVITY,) + (0.0,) * 6))
