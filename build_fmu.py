@@ -44,19 +44,22 @@ def _tool(name: str) -> str | None:
     return shutil.which(name) or (str(beside) if beside.is_file() else None)
 
 
-def cmake_build(build_dir, targets=(), options=(), source=ROOT) -> Path:
+def cmake_build(build_dir, targets=(), options=(), source=ROOT, quiet: bool = False) -> Path:
     """CMake's build of the clone at source in build_dir: configured first where it is not yet (with
     this Python, Ninja where there is one, the -D options), then the targets built (every one
-    without). Raises subprocess.CalledProcessError; returns build_dir."""
+    without). Raises subprocess.CalledProcessError (quiet: CMake's and the compiler's output kept
+    for its output instead of shown); returns build_dir."""
     cmake, build_dir = _tool("cmake"), Path(build_dir)
     if cmake is None:
         raise FileNotFoundError("building a clone needs CMake: pip install cmake ninja")
+    output = {"capture_output": True, "text": True} if quiet else {}
     if not (build_dir / "CMakeCache.txt").is_file():
         ninja = _tool("ninja")
         generator = ["-G", "Ninja", f"-DCMAKE_MAKE_PROGRAM={ninja}"] if ninja else []
         subprocess.run([cmake, "-S", str(source), "-B", str(build_dir), *generator,
-                        f"-DPython_EXECUTABLE={sys.executable}", *(f"-D{o}" for o in options)], check=True)
-    subprocess.run([cmake, "--build", str(build_dir), *(a for t in targets for a in ("--target", t))], check=True)
+                        f"-DPython_EXECUTABLE={sys.executable}", *(f"-D{o}" for o in options)], check=True, **output)
+    subprocess.run([cmake, "--build", str(build_dir), *(a for t in targets for a in ("--target", t))], check=True,
+                   **output)
     return build_dir
 
 

@@ -29,6 +29,8 @@ CONVENTIONS = {
     "rate over (t[k], t[k+1]] and the specific force, magnetic field and true orientation at t[k+1]. The "
     "FMU has no inputs.",
 }
+EXPORTED = STEP + ("After the step the outputs are the exported python-control system's outputs at sample k, as "
+                   "control.input_output_response computes them (attitude_fmu.export_fmu).")
 
 
 def _start(v) -> str:
@@ -43,9 +45,9 @@ def _unit(v) -> str:
     return f"{v.unit} (shown in {DISPLAY_UNITS[v.unit][0]})" if v.unit in DISPLAY_UNITS else v.unit
 
 
-def index_html(name: str, description: str, fmi: str, version: str, variables) -> str:
+def index_html(name: str, description: str, fmi: str, version: str, variables, convention: str | None = None) -> str:
     """documentation/index.html of the FMU name (FMI version fmi, the project's version): its
-    description, the time convention, and a table of its variables by causality."""
+    description, the time convention (default CONVENTIONS[name]), and a table of its variables by causality."""
     rows = []
     for causality, title in ((IN, "Inputs"), (OUT, "Outputs"), ("parameter", "Parameters")):
         chosen = [v for v in variables if v.causality == causality]
@@ -68,7 +70,7 @@ def index_html(name: str, description: str, fmi: str, version: str, variables) -
         f"<p>FMI {escape(fmi)} co-simulation; attitude-fmu {escape(version)}. Units are SI; angles are "
         "computed in rad and shown in deg. Quaternions are [w, x, y, z], sensor to earth (ENU, z up).</p>",
         "<h2>Time convention</h2>",
-        f"<p>{escape(CONVENTIONS[name])}</p>",
+        f"<p>{escape(convention or CONVENTIONS[name])}</p>",
         "<h2>Variables</h2>",
         '<table border="1" cellpadding="3">',
         "<tr><th>name</th><th>value reference</th><th>type</th><th>unit</th><th>start</th><th>description</th></tr>",
@@ -82,9 +84,11 @@ def index_html(name: str, description: str, fmi: str, version: str, variables) -
     ])
 
 
-def documentation_files(name: str, description: str, fmi: str, version: str, variables) -> dict[str, bytes]:
-    """The FMU's documentation/ files by their path in it."""
-    return {"documentation/index.html": index_html(name, description, fmi, version, variables).encode("utf-8"),
+def documentation_files(name: str, description: str, fmi: str, version: str, variables,
+                        convention: str | None = None) -> dict[str, bytes]:
+    """The FMU's documentation/ files by their path in it (convention: index_html's)."""
+    return {"documentation/index.html": index_html(name, description, fmi, version, variables,
+                                                   convention).encode("utf-8"),
             "documentation/licenses/LICENSE": LICENSE_FILE.read_bytes()}
 
 

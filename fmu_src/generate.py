@@ -66,10 +66,12 @@ GUID_NAMESPACE = uuid.UUID("6f0e2a4c-8b1d-4c55-9d3e-2f7a1b9c0d41")  # of the nat
 
 @dataclass(frozen=True)
 class NativeModel:
-    """A native FMU's interface (a table of fmu_src.variables) and description."""
+    """A native FMU's interface (a table of fmu_src.variables), description and, where it is not
+    documentation.CONVENTIONS', its time convention."""
 
     interface: object
     description: str
+    convention: str | None = None
 
 
 MODELS = {
@@ -99,20 +101,22 @@ def _identifier(name: str) -> str:
     return name
 
 
-def variables_header(name: str, guid: str) -> str:
-    """The text of <name>_variables.h: the model's variables as the plumbing takes them
-    (fmi2/fmi2_model.h: Fmi2Variable, by value reference) and the index of each among those
-    of its type (REAL_<variable>, INTEGER_…, BOOLEAN_…, STRING_…; an Enumeration's among the
-    integers, its item names in ITEMS_<variable>), which the model file uses."""
-    variables = MODELS[name].interface()
+def variables_header(name: str, guid: str, model: NativeModel | None = None) -> str:
+    """The text of <name>_variables.h: the model's variables (model, default MODELS[name]) as the
+    plumbing takes them (fmi2/fmi2_model.h: Fmi2Variable, by value reference) and the index of each
+    among those of its type (REAL_<variable>, INTEGER_…, BOOLEAN_…, STRING_…; an Enumeration's among
+    the integers, its item names in ITEMS_<variable>), which the model file uses; where a name is no C
+    identifier (an exported diagram's u[0]), the counts N_REALS, … alone."""
+    variables = (model or MODELS[name]).interface()
+    indexed = all(v.name.isidentifier() and v.name.isascii() for v in variables)
     if [v.value_reference for v in variables] != list(range(len(variables))):
         raise ValueError(f"{name}: the plumbing needs value references 0, 1, 2, … in the table's order")
     if len(LOG_CATEGORIES) > 32:
         raise ValueError("more log categories than fmi2/fmi2_model.h's FMI2_MAX_CATEGORIES")
     lines, items = [], []
     for type_ in (REAL, INTEGER, BOOLEAN, STRING):
-        names = [_identifier(v.name) for v in variables if HELD_AS[v.type] == type_]
-        if names:
+        names = [_identifier(v.name) if indexed else v.name for v in variables if HELD_AS[v.type] == type_]
+        if names and indexed:
             lines += ["enum {", *(f"    {type_.upper()}_{n} = {i}," for i, n in enumerate(names)), "};"]
         lines.append(f"#define N_{type_.upper()}S {len(names)}")
     rows = []
@@ -122,8 +126,10 @@ def variables_header(name: str, guid: str) -> str:
             items.append(f"static const char *const ITEMS_{v.name}[{len(v.items)}] = "
                          f"{{{', '.join(c_string(item) for item in v.items)}}};")
         enumeration = (f"ITEMS_{v.name}", str(len(v.items))) if v.type == ENUMERATION else ("NULL", "0")
+        index = f"{HELD_AS[v.type].upper()}_{v.name}" if indexed else str(
+            sum(HELD_AS[w.type] == HELD_AS[v.type] for w in variables[:v.value_reference]))
         rows.append(f"    {{{c_string(v.name)}, FMI2_{v.type.upper()}, FMI2_{v.causality.upper()}, "
-                    f"FMI2_{v.variability.upper()}, {_initial(v)}, {HELD_AS[v.type].upper()}_{v.name}, "
+                    f"FMI2_{v.variability.upper()}, {_initial(v)}, {index}, "
                     f"{start[0]}, {start[1]}, {', '.join(enumeration)}}}, /* {v.value_reference} */")
     guard = f"{name.upper()}_VARIABLES_H"
     return "\n".join([
@@ -160,10 +166,11 @@ def variables_header(name: str, guid: str) -> str:
     ])
 
 
-def guid(name: str, fmi: str, sources: dict[str, bytes]) -> str:
+def guid(name: str, fmi: str, sources: dict[str, bytes], model: NativeModel | None = None) -> str:
     """The FMU's guid (FMI 3.0: instantiation token): a digest of its sources (path under
-    sources/ → contents; the generated variables header aside), its variables and its description."""
-    model = MODELS[name]
+    sources/ → contents; the generated variables header aside), its variables and its description
+    (model, default MODELS[name])."""
+    model = model or MODELS[name]
     digest = hashlib.sha256(b"fmi3" if fmi == "3.0" else b"")
     for path, data in sorted(sources.items()):
         digest.update(f"{path}\0{len(data)}\0".encode())
@@ -199,22 +206,25 @@ def build_description(name: str, fmi: str, c_files, headers) -> bytes:
     return tostring(root, xml_declaration=True, encoding="UTF-8")
 
 
-def generated_files(name: str, fmi: str, version: str, sources: dict[str, bytes]) -> dict[str, bytes]:
+def generated_files(name: str, fmi: str, version: str, sources: dict[str, bytes], model: NativeModel | None = None,
+                    step: float | None = None) -> dict[str, bytes]:
     """The FMU's files by their path in it but its binary: modelDescription.xml and sources/ (the
-    given sources, the variables header, buildDescription.xml)."""
+    given sources, the variables header, buildDescription.xml) of the model (default MODELS[name]);
+    step: the DefaultExperiment's step size (s; None: the project's default)."""
     if fmi not in ("2.0", "3.0"):
         raise ValueError(f"FMI version {fmi!r}: 2.0 or 3.0")
-    model, token = MODELS[name], guid(name, fmi, sources)
-    files = {**sources, f"{name}_variables.h": variables_header(name, token).encode("ascii")}
+    model = model or MODELS[name]
+    token = guid(name, fmi, sources, model)
+    files = {**sources, f"{name}_variables.h": variables_header(name, token, model).encode("ascii")}
     c_files = sorted(p for p in files if p.endswith(".c"))
     if fmi == "3.0":
-        md = model_description3(name, model.description, token, model.interface(), version)
+        md = model_description3(name, model.description, token, model.interface(), version, step=step)
     else:
-        md = model_description(name, model.description, token, model.interface(), version, c_files)
+        md = model_description(name, model.description, token, model.interface(), version, c_files, step=step)
     files["buildDescription.xml"] = build_description(name, fmi, c_files, sorted(p for p in files if p.endswith(".h")))
     return {"modelDescription.xml": tostring(md, xml_declaration=True, encoding="UTF-8"),
             **{f"sources/{path}": data for path, data in files.items()},
-            **documentation_files(name, model.description, fmi, version, model.interface())}
+            **documentation_files(name, model.description, fmi, version, model.interface(), model.convention)}
 
 
 def write_stage(stage, files: dict[str, bytes]) -> None:

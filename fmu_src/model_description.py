@@ -62,8 +62,10 @@ def metadata(version: str) -> dict[str, str]:
             "generationDateAndTime": time.strftime("%Y-%m-%dT%H:%M:%SZ", stamp)}
 
 
-def default_experiment() -> Element:
-    return Element("DefaultExperiment", startTime="0.0", stopTime=repr(DEFAULT_STOP), stepSize=repr(DEFAULT_STEP))
+def default_experiment(step: float | None = None) -> Element:
+    """0 s to DEFAULT_STOP at step (s; None: DEFAULT_STEP)."""
+    return Element("DefaultExperiment", startTime="0.0", stopTime=repr(DEFAULT_STOP),
+                   stepSize=repr(float(step or DEFAULT_STEP)))
 
 
 def unit_definitions(variables) -> Element:
@@ -140,11 +142,12 @@ def model_structure(variables) -> Element:
     return structure
 
 
-def model_description(name: str, description: str, guid: str, variables, version: str, source_files=()) -> Element:
+def model_description(name: str, description: str, guid: str, variables, version: str, source_files=(),
+                      step: float | None = None) -> Element:
     """The modelDescription.xml of an FMI 2.0 co-simulation FMU in C whose binary is named
     name (its model identifier): the variables of the table, the capabilities of the
     project's FMI plumbing (fmu_src/fmi2), its sources (paths under sources/), the metadata of
-    the project's version."""
+    the project's version; step: the DefaultExperiment's (default_experiment)."""
     root = Element("fmiModelDescription", {
         "fmiVersion": "2.0", "modelName": name, "guid": guid, "description": description,
         "generationTool": f"attitude-fmu {version}", "variableNamingConvention": "structured", **metadata(version)})
@@ -157,10 +160,9 @@ def model_description(name: str, description: str, guid: str, variables, version
         files = SubElement(cosimulation, "SourceFiles")
         for path in source_files:
             SubElement(files, "File", name=path)
-    root.append(unit_definitions(variables))
-    root.append(type_definitions(variables))
+    root.extend(d for d in (unit_definitions(variables), type_definitions(variables)) if len(d))  # none empty
     root.append(log_categories())
-    root.append(default_experiment())
+    root.append(default_experiment(step))
     root.append(model_variables(variables))
     root.append(model_structure(variables))
     return root
@@ -219,7 +221,8 @@ def model_variables3(variables) -> Element:
     return node
 
 
-def model_description3(name: str, description: str, instantiation_token: str, variables, version: str) -> Element:
+def model_description3(name: str, description: str, instantiation_token: str, variables, version: str,
+                       step: float | None = None) -> Element:
     """The modelDescription.xml of an FMI 3.0 co-simulation FMU in C whose binary is named name,
     with the capabilities of fmu_src/fmi3 and the metadata of the project's version. No output
     depends on an input within a step (model_structure)."""
@@ -233,10 +236,10 @@ def model_description3(name: str, description: str, instantiation_token: str, va
         "providesAdjointDerivatives": "false", "canHandleVariableCommunicationStepSize": "true",
         "maxOutputDerivativeOrder": "0", "providesIntermediateUpdate": "false",
         "canReturnEarlyAfterIntermediateUpdate": "false", "hasEventMode": "false"})
-    root.append(unit_definitions([*variables, time_variable(variables)]))
-    root.append(type_definitions3([*variables, time_variable(variables)]))
+    root.extend(d for d in (unit_definitions([*variables, time_variable(variables)]),
+                            type_definitions3([*variables, time_variable(variables)])) if len(d))  # none empty
     root.append(log_categories())
-    root.append(default_experiment())
+    root.append(default_experiment(step))
     root.append(model_variables3(variables))
     structure = SubElement(root, "ModelStructure")
     for v in variables:

@@ -3,7 +3,8 @@ zig's compiler): every FMU holds them; each binary's header names its format and
 export table the FMI functions; the Linux ones need glibc 2.17 at most; the Windows ones, under wine,
 and the aarch64 Linux ones, under qemu-user, in a C host built by the same toolchain
 (tests/fmi_runner.c), give the outputs of this machine's build under fmpy within 1e-12 on a 30 s
-stream. The macOS binaries are checked for format, architecture and exports only.
+stream. The macOS binaries are checked for format, architecture and exports only. The same for a
+python-control diagram exported with every platform's binaries (attitude_fmu.export_fmu).
 
 One cross build per platform for the whole session (build/tests-platforms/platform-<tuple>, warnings
 as errors), merged into copies of this machine's FMUs (tests/native.py's build)."""
@@ -334,3 +335,57 @@ def test_the_aarch64_linux_binary_under_qemu_equals_this_machines_under_fmpy(pla
     table = runner_replay([qemu, "-L", str(AARCH64_SYSROOT), str(runners["aarch64-linux"])], fmus[name, 3],
                           "aarch64-linux", rows, tmp_path)
     assert_same(table, fmpy_replay(host_fmus[name, 3], rows), (name, 3))
+
+
+# ---- a python-control diagram exported with every platform's binaries (attitude_fmu.export_fmu)
+@pytest.fixture(scope="module")
+def exported_fmus(platform_fmus, tmp_path_factory):
+    """The gyro-offset stage and wiener as one diagram (systems.evaluation.bench.exported_estimator), FMI 2.0
+    and 3.0, for this machine only and for every platform: {(fmi, "host" | "all"): path}."""
+    from attitude_fmu.systems.evaluation.bench import exported_estimator
+
+    fmus = {}
+    for fmi in (2, 3):
+        for which in ("host", "all"):
+            folder = tmp_path_factory.mktemp(f"exported-{which}-fmi{fmi}")
+            fmus[fmi, which] = exported_estimator(folder / "ExportedEstimator.fmu", f"{fmi}.0", which)
+    return fmus
+
+
+def exported_rows() -> np.ndarray:
+    """The stream as replay rows (t, h, gyr, acc) of the exported diagram, at its own step."""
+    s = stream()
+    return np.column_stack([s["t"], np.full(len(s["t"]), STEP_S), s["gyr"], s["acc"]])
+
+
+@pytest.mark.parametrize("fmi", [2, 3])
+def test_an_exported_diagram_holds_every_platforms_binary_and_each_runs_as_this_machines(exported_fmus,
+                                                                                        platform_fmus, wine, fmi,
+                                                                                        tmp_path):
+    """Every binaries folder of the FMI version, each binary of its format and architecture exporting the
+    standard's functions; the zig-built x86-64 Linux binary under fmpy, the Windows one under wine and (FMI
+    3.0) the aarch64 Linux one under qemu-user give this machine's compiler's outputs within 1e-12."""
+    fmu, name = exported_fmus[fmi, "all"], "ExportedEstimator"
+    with zipfile.ZipFile(fmu) as zf:
+        binaries = {n for n in zf.namelist() if n.startswith("binaries/") and not n.endswith("/")}
+        assert binaries == {f"binaries/{f}/{library_name(name, platform_of(f))}" for f in folders(fmi)}
+        for folder in folders(fmi):
+            platform = platform_of(folder)
+            header = {"linux": elf_header, "windows": pe_header, "darwin": macho_header}[platform.split("-")[1]]
+            arch, exports = header(zf.read(f"binaries/{folder}/{library_name(name, platform)}"))[:2]
+            assert arch == platform.split("-")[0]
+            assert {e for e in exports if e.startswith(("fmi2", "fmi3"))} == standard_functions(fmi), folder
+    rows = exported_rows()
+    reference = fmpy_replay(exported_fmus[fmi, "host"], rows)
+    assert_same(fmpy_replay(fmu, rows), reference, ("zig x86_64-linux", fmi))
+    _, runners = platform_fmus
+    (tmp_path / "wine").mkdir()
+    table = runner_replay([wine[0], str(runners["x86_64-windows"])], fmu, "win64" if fmi == 2 else "x86_64-windows",
+                          rows, tmp_path / "wine", windows_path, wine[1])
+    assert_same(table, reference, ("windows", fmi))
+    qemu = shutil.which("qemu-aarch64")
+    if fmi == 3 and qemu and (AARCH64_SYSROOT / "lib" / "ld-linux-aarch64.so.1").exists():
+        (tmp_path / "qemu").mkdir()
+        table = runner_replay([qemu, "-L", str(AARCH64_SYSROOT), str(runners["aarch64-linux"])], fmu,
+                              "aarch64-linux", rows, tmp_path / "qemu")
+        assert_same(table, reference, ("aarch64-linux", fmi))

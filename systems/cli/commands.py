@@ -15,8 +15,8 @@ import numpy as np
 
 from attitude_fmu.blocks.methods.registry import METHODS
 from attitude_fmu.blocks.methods.registry import method as known_method
-from attitude_fmu.blocks.pipeline.causal import ESTIMATORS
 from attitude_fmu.blocks.params import GYRO_NOISE, TIME_S
+from attitude_fmu.blocks.pipeline.causal import ESTIMATORS
 from attitude_fmu.blocks.stages.timing import ACC_SAMPLES, GYR_SAMPLES, MAX_LATENCY_S
 from attitude_fmu.systems.recordings.checks import RATE_RANGE_HZ
 from attitude_fmu.systems.recordings.output import STDIO, check_output, same_file
@@ -363,6 +363,25 @@ def build_parser() -> argparse.ArgumentParser:
     bd.add_argument("--method", default="tseng", choices=sorted(m for m in METHODS if METHODS[m].is_sensor_frame),
                     help="a method with an earth-frame filter (default tseng)")
     bd.add_argument("--out", help="PNG to write (default bode_METHOD.png)")
+
+    ex = sub.add_parser("export", help="a python-control system (a diagram of state spaces, transfer functions and "
+                        "the project's blocks) as a native FMU in C",
+                        description="Export NAME of FILE.py (a python-control system, or a function of no arguments "
+                        "returning one or (system, x0)) as a co-simulation FMU: after the doStep that ends at t[k+1], "
+                        "with the inputs of sample k held over it, the outputs are the system's at sample k as "
+                        "control.input_output_response computes them.")
+    ex.add_argument("system", metavar="FILE.py:NAME", help="the system to export")
+    ex.add_argument("--out", type=Path, required=True, metavar="PATH.fmu", help="the FMU to write")
+    ex.add_argument("--step", type=_number(0.0, MAX_TIME_S, "s", above=True),
+                    help="the DefaultExperiment's step (s): a continuous system's communication step (default 0.01 "
+                         "s); a discrete one's must be its dt")
+    ex.add_argument("--fmi-version", choices=("2.0", "3.0"), default="2.0", help="FMI version (default 2.0)")
+    ex.add_argument("--platforms", default="host", help="binaries for: host (the default), all, or a comma-separated "
+                    "list of x86_64-linux, aarch64-linux, x86_64-windows, x86_64-darwin, aarch64-darwin (needs ziglang)")
+    ex.add_argument("--name", help="the FMU's model identifier (default the system's name)")
+    ex.add_argument("--backend", choices=("native", "python"), default="native",
+                    help="native: C, no Python where it runs (default); python: pythonfmu, any discrete system, "
+                         "Python functions included (needs a Python with attitude_fmu where it runs)")
 
     bn = sub.add_parser("bench", help="samples per second of the batch estimator, vqf and ahrs Madgwick")
     _add_json_flag(bn, "the lines")
@@ -785,6 +804,8 @@ def cmd_bench(args) -> int:
             for name, us in result["c_host_us_per_step"].items():
                 print(f"{name:>24} {us:8.3f} µs/step")
             print(f"{'native speed-up':>24} {result['native_speedup_c_host']:8.1f}  (pythonfmu / native; target ≥ 20)")
+            print(f"{'exported ratio':>24} {result['exported_ratio_c_host']:8.2f}  (export_fmu of the same pipeline "
+                  f"from python-control blocks / native; target ≤ 1.2)")
         return 0
     result = bench(n=args.samples, repeat=args.repeat)
     if args.json:
@@ -797,12 +818,24 @@ def cmd_bench(args) -> int:
     return 0
 
 
+def cmd_export(args) -> int:
+    from attitude_fmu.systems.fmi.export.api import export_fmu
+    from attitude_fmu.systems.fmi.export.source import load_system
+
+    _check_out(args.out)
+    system, x0 = load_system(args.system)
+    path = export_fmu(system, args.out, x0=x0, step=args.step, fmi_version=args.fmi_version, platforms=args.platforms,
+                      name=args.name, backend=args.backend, log=lambda m: print(f"attitude: {m}", file=sys.stderr))
+    print(path)
+    return 0
+
+
 def main(argv=None) -> int:
     try:
         args = build_parser().parse_args(argv)
         handler = {"estimate": cmd_estimate, "evaluate": cmd_evaluate, "sweep": cmd_sweep, "plot": cmd_plot,
                    "table1": cmd_table1, "verify": cmd_verify, "ssp": cmd_ssp, "compare": cmd_compare,
-                   "bode": cmd_bode, "bench": cmd_bench}[args.command]
+                   "bode": cmd_bode, "bench": cmd_bench, "export": cmd_export}[args.command]
         return handler(args)
     except (ValueError, OSError, RuntimeError) as exc:
         print(f"attitude: error: {exc}", file=sys.stderr)

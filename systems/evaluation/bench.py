@@ -132,9 +132,11 @@ def _c_host_rounds(fmus: dict, inputs, repeat: int, tmp: Path, progress: bool) -
         vr = {v.name: v.valueReference for v in md.modelVariables}
         identifier = md.coSimulation.modelIdentifier
         binary = Path(folder) / "binaries" / fmpy.platform / f"{identifier}{fmpy.sharedLibraryExtension}"
+        outputs = [n for n in md.modelVariables if n.causality == "output" and n.type == "Real"]
         proc = subprocess.run([str(host), str(binary), md.guid, (Path(folder) / "resources").as_uri(), str(data),
                                repr(1.0 / BENCH_FS), str(repeat), ",".join(str(vr[n]) for n in FMU_INPUTS),
-                               ",".join(str(vr[n]) for n in FMU_OUTPUTS), str(vr["valid"])],
+                               ",".join(str(v.valueReference) for v in outputs),
+                               str(vr["valid"]) if "valid" in vr else "-"],
                               capture_output=True, text=True)
         if proc.returncode != 0:
             raise RuntimeError(f"the C host failed on {name} ({proc.returncode}): {proc.stderr[-2000:]}")
@@ -152,7 +154,10 @@ def bench_fmu(steps: int = 5000, repeat: int = 5, progress: bool = True) -> dict
     Under fmpy (set inputs, doStep, get outputs, in interleaved rounds): the pythonfmu
     AttitudeEstimator.fmu and NoOpEstimator.fmu, and the native ones (native/…; in C).
     In a C host with no Python in its process: the native AttitudeEstimator.fmu against the
-    pythonfmu one (c_host; native_speedup = pythonfmu's cost / native's). All in one run."""
+    pythonfmu one (c_host; native_speedup = pythonfmu's cost / native's), and against the same
+    estimator (its defaults: the gyro-offset stage, then wiener) assembled from python-control blocks
+    and exported by export_fmu (exported_ratio = its cost / the native FMU's). Each gets every Real
+    output after each step. All in one run."""
     from fmpy import extract, read_model_description
 
     from attitude_fmu.systems.fmi.build import build_fmus
@@ -172,15 +177,39 @@ def bench_fmu(steps: int = 5000, repeat: int = 5, progress: bool = True) -> dict
         if set(fmus) != {*names, *(f"native/{n}" for n in names)}:
             raise RuntimeError("attitude bench --fmu needs the native FMUs, which the package's build makes "
                                "(see the warning above)")
-        per_step = _fmpy_rounds(fmus, inputs, steps, repeat, progress)
-        c_host = _c_host_rounds({n: fmus[n] for n in ("native/AttitudeEstimator", "AttitudeEstimator")}, inputs,
-                                repeat, Path(tmp), progress)
+        exported = exported_estimator(Path(tmp) / "ExportedEstimator.fmu")
+        fmus["exported/ExportedEstimator"] = (read_model_description(exported), extract(exported))
+        per_step = _fmpy_rounds({n: fmus[n] for n in fmus if not n.startswith("exported/")}, inputs, steps, repeat,
+                                progress)
+        c_host = _c_host_rounds({n: fmus[n] for n in ("native/AttitudeEstimator", "AttitudeEstimator",
+                                                      "exported/ExportedEstimator")}, inputs, repeat, Path(tmp),
+                                progress)
     return {"steps": steps, "us_per_step": per_step,
             "ratio_vs_noop": per_step["AttitudeEstimator"] / per_step["NoOpEstimator"],
             "native_ratio_vs_noop": per_step["native/AttitudeEstimator"] / per_step["native/NoOpEstimator"],
             "c_host_us_per_step": c_host,
-            "native_speedup_c_host": c_host["AttitudeEstimator"] / c_host["native/AttitudeEstimator"]}
+            "native_speedup_c_host": c_host["AttitudeEstimator"] / c_host["native/AttitudeEstimator"],
+            "exported_ratio_c_host": c_host["exported/ExportedEstimator"] / c_host["native/AttitudeEstimator"]}
 
+
+def exported_estimator(path: Path, fmi_version: str = "2.0", platforms: str = "host") -> Path:
+    """The native AttitudeEstimator's default pipeline (gyro-offset stage, then wiener, at BENCH_FS) as a
+    python-control diagram, exported by export_fmu to path (its FMI version and platforms)."""
+    import control
+
+    from attitude_fmu.blocks.methods.registry import estimator_system
+    from attitude_fmu.blocks.stages.gyro_offset import offset_system
+    from attitude_fmu.systems.fmi.export.api import export_fmu
+
+    dt = 1.0 / BENCH_FS
+    names = [f"{s}_{a}" for s in ("gyr", "acc") for a in "xyz"]
+    diagram = control.interconnect(
+        [offset_system(dt), estimator_system("wiener", dt=dt)], name="ExportedEstimator", inputs=names,
+        inplist=[f"gyro_offset.gyr_raw_{a}" for a in "xyz"] + [[f"gyro_offset.acc_{a}", f"estimator.acc_{a}"]
+                                                               for a in "xyz"],
+        outlist=[f"estimator.{n}" for n in ("ghat_x", "ghat_y", "ghat_z", "q_w", "q_x", "q_y", "q_z")],
+        connections=[[f"estimator.gyr_{a}", f"gyro_offset.gyr_{a}"] for a in "xyz"])
+    return export_fmu(diagram, path, fmi_version=fmi_version, platforms=platforms)
 
 
 def bench_workers(files=(), workers: int = 2, duration: float = 20000.0) -> dict:

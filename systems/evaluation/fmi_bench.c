@@ -3,7 +3,8 @@
  *   fmi_bench BINARY GUID RESOURCE_URI DATA H ROUNDS VR_IN VR_OUT VR_VALID
  * DATA holds rows of raw doubles, one value per input of VR_IN (value references separated by
  * commas); each round resets the FMU, initialises it with its start values and, per row, sets
- * the inputs, steps H seconds and gets the outputs VR_OUT and the Boolean VR_VALID. Prints the
+ * the inputs, steps H seconds and gets the outputs VR_OUT and the Boolean VR_VALID ("-": an FMU without
+ * one, as an exported diagram, gets no Boolean). Prints the
  * best round's nanoseconds per step, then ends with _exit: pythonfmu's library finalises its
  * interpreter from a destructor that can crash at process exit. */
 #define _POSIX_C_SOURCE 199309L
@@ -59,6 +60,7 @@ int main(int argc, char **argv) {
     FIND(fmi2DoStepTYPE, fmi2DoStep);
 #undef FIND
     fmi2ValueReference vr_in[MAX_VRS], vr_out[MAX_VRS], vr_valid = (fmi2ValueReference)atoi(argv[9]);
+    const int has_valid = strcmp(argv[9], "-") != 0;
     size_t n_in = references(argv[7], vr_in), n_out = references(argv[8], vr_out);
     FILE *data = fopen(argv[4], "rb");
     if (!data) return 4;
@@ -82,7 +84,7 @@ int main(int argc, char **argv) {
             status |= fmi2SetReal(c, vr_in, n_in, inputs + k * n_in);
             status |= fmi2DoStep(c, k * h, h, fmi2True);
             status |= fmi2GetReal(c, vr_out, n_out, outputs);
-            status |= fmi2GetBoolean(c, &vr_valid, 1, &valid);
+            if (has_valid) status |= fmi2GetBoolean(c, &vr_valid, 1, &valid);
         }
         double elapsed = (now() - start) / (double)steps;
         if (elapsed < best) best = elapsed;

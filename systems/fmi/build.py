@@ -170,12 +170,9 @@ def build_fmus(out, names=FMU_NAMES, native=NATIVE_NAMES, fmi3_names=fmi3.FMI3_N
                                                         needsExecutionTool="false", canGetAndSetFMUstate="true",
                                                         canSerializeFMUstate="true")))
     for path in built_fmus:
-        if guard is not None:
-            install_guard(path, guard)
+        guarded(path, guard)
         with zipfile.ZipFile(path, "a", zipfile.ZIP_DEFLATED) as zf:
             zf.writestr(FINGERPRINT, source_fingerprint(path.stem) + "\n")
-            zf.writestr(PYTHON_ENVIRONMENT, python_environment())
-            zf.writestr(VARIABLE_TYPES, variable_types(zf.read("modelDescription.xml")))
     copied = copy_fmus(out / "native", native) + fmi3.copy_fmi3_fmus(out / "native" / "fmi3", fmi3_names)
     if platforms and copied:
         cross.add_platforms(copied, platforms, log=lambda m: print(m, file=sys.stderr))
@@ -222,6 +219,17 @@ def install_guard(fmu: Path, guard: Path) -> None:
                 dst.write(guard, binary)
             dst.writestr(name if name != item.filename else item, src.read(item))
     staged.replace(fmu)
+
+
+def guarded(fmu: Path, guard: Path | None) -> None:
+    """A pythonfmu FMU made the project's: guard (guard_binary; None: pythonfmu's own binary kept) its
+    binary, the interpreter it starts in a host without Python (python_environment) and its variables'
+    types (variable_types) in its resources."""
+    if guard is not None:
+        install_guard(fmu, guard)
+    with zipfile.ZipFile(fmu, "a", zipfile.ZIP_DEFLATED) as zf:
+        zf.writestr(PYTHON_ENVIRONMENT, python_environment())
+        zf.writestr(VARIABLE_TYPES, variable_types(zf.read("modelDescription.xml")))
 
 
 def ensure_built(fmu_dir, rebuild: bool = False, log=print, platforms=()) -> Path:

@@ -1,0 +1,1 @@
+"""Export of python-control systems as FMUs (export_fmu)."""

@@ -1,0 +1,80 @@
+"""export_fmu: any python-control diagram of state spaces, transfer functions and the project's blocks
+as a native co-simulation FMU (FMI 2.0 or 3.0), or any discrete python-control system as a pythonfmu
+FMU (backend="python")."""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from attitude_fmu.systems.fmi.export.flatten import ExportError, flatten
+
+BACKENDS = ("native", "python")
+
+
+def _model_name(system, name: str | None) -> str:
+    """The FMU's model identifier: name, or the system's name; ValueError unless a C identifier."""
+    name = name if name is not None else system.name
+    if not (isinstance(name, str) and name.isidentifier() and name.isascii()):
+        raise ValueError(f"the FMU's name (model identifier) must be a C identifier, got {name!r}: give name=")
+    return name
+
+
+def export_fmu(system, path, *, x0=None, step: float | None = None, fmi_version: str = "2.0",
+               platforms: str = "host", name: str | None = None, backend: str = "native",
+               log=lambda message: None) -> Path:
+    """system (a python-control system) as a co-simulation FMU written to path; returns its path.
+
+    system: a control.StateSpace or TransferFunction (SISO or MIMO; discrete ones step at their dt,
+    continuous ones are held by zero-order hold over each communication step), one of the project's
+    blocks (estimator_system, offset_system, heading_system, latency_system, ImuModel.system,
+    HumanMotion.system, ClosedForm.system, magnetometer_system, attitude_error_system), or a
+    control.interconnect of these, nested to any depth. After the doStep that ends at t[k+1], with
+    the inputs of sample k held over it, the outputs are the system's outputs at sample k as
+    control.input_output_response computes them.
+    x0: the initial state (python-control's state vector; None: zeros, which for the project's
+    blocks means at rest on the first sample); step: the DefaultExperiment's step (s; default the
+    system's dt, 0.01 s for a continuous one); a discrete system refuses another communication step;
+    fmi_version: "2.0" or "3.0"; platforms: "host", "all" or FMI 3.0 platform tuples
+    (systems.fmi.platforms; needs the `platforms` extra); name: the model identifier (default the
+    system's name); backend: "native" (C, no Python at run time) or "python" (pythonfmu: any discrete
+    system, Python functions included; the FMU needs a Python with attitude_fmu and control where it
+    runs); log: progress messages.
+    ExportError names a block that cannot be exported natively (a Python-function block, an
+    algebraic loop) and why; ValueError for bad arguments."""
+    from attitude_fmu.systems.fmi.platforms import parse_platforms
+
+    if backend not in BACKENDS:
+        raise ValueError(f"backend must be one of {', '.join(BACKENDS)}, got {backend!r}")
+    if fmi_version not in ("2.0", "3.0"):
+        raise ValueError(f"fmi_version must be '2.0' or '3.0', got {fmi_version!r}")
+    model = _model_name(system, name)
+    path = Path(path)
+    if path.suffix != ".fmu":
+        raise ValueError(f"the FMU's path must end in .fmu, got {str(path)!r}")
+    if step is not None and not (isinstance(step, (int, float)) and math.isfinite(step) and step > 0):
+        raise ValueError(f"step must be a finite positive number of seconds, got {step!r}")
+    nstates = system.nstates if hasattr(system, "nstates") else 0
+    if x0 is not None:
+        x0 = np.asarray(x0, dtype=float).ravel()
+        if x0.size != nstates or not np.isfinite(x0).all():
+            raise ValueError(f"x0 must hold {nstates} finite values (the system's states), got {x0.size}")
+    if backend == "python":
+        from attitude_fmu.systems.fmi.export.python import write_python
+
+        return write_python(path, model, system, x0, step, fmi_version)
+    diagram = flatten(system)
+    if diagram.dt and step is not None and not math.isclose(step, diagram.dt, rel_tol=1e-9):
+        raise ValueError(f"{system.name} is discrete with sample time {diagram.dt!r} s: it steps at that, not at "
+                         f"{step!r} s")
+    from attitude_fmu.systems.fmi.export.native import write_native
+
+    description = (f"python-control system {system.name} exported by attitude_fmu.export_fmu: {len(diagram.blocks)} "
+                   f"block(s) in C ({', '.join(sorted({b.kind for b in diagram.blocks}))}), "
+                   + (f"sample time {diagram.dt!r} s" if diagram.dt else "continuous, held by zero-order hold"))
+    return write_native(path, model, fmi_version, diagram, x0, step or diagram.dt or 0.01, description,
+                        parse_platforms(platforms), log)
+
+
+__all__ = ["ExportError", "export_fmu"]
