@@ -28,9 +28,17 @@ from attitude_fmu.systems.simulation.diagram import closed_loop
 from attitude_fmu.systems.simulation.motion import HumanMotion
 from attitude_fmu.systems.simulation.noise import MOTION, SENSOR, normals
 from attitude_fmu.systems.simulation.sensor_model import ImuModel
+from tests import native
 
 TOLERANCE = 1e-9
+# the generated C warning-free (-Wall -Wextra as errors), with the sanitizers in the sanitized run (tests/native.py)
+BUILD = ("AF_WERROR=ON", *(("AF_SANITIZE=ON",) if native.sanitized_build() is not None else ()))
 warnings.filterwarnings("ignore", message=".*(duplicate|Unused|multiple connections).*")
+
+
+def export(system, path, **options):
+    """export_fmu of the native backend as the tests build it (BUILD)."""
+    return export_fmu(system, path, cmake_options=BUILD, **options)
 
 
 def fmu_outputs(path, inputs: np.ndarray, h: float, system) -> np.ndarray:
@@ -75,7 +83,7 @@ def test_random_discrete_state_spaces(tmp_path, fmi, draw_seed, states, inputs, 
     dt = 0.05
     system = stable_discrete(draw_seed, states, inputs, outputs, feedthrough, dt)
     x0 = np.random.default_rng(draw_seed + 1).normal(size=states)
-    path = export_fmu(system, tmp_path / "random.fmu", x0=x0, fmi_version=fmi)
+    path = export(system, tmp_path / "random.fmu", x0=x0, fmi_version=fmi)
     u = np.random.default_rng(draw_seed + 2).normal(size=(80, inputs))
     np.testing.assert_allclose(fmu_outputs(path, u, dt, system), reference(system, u, dt, x0), rtol=0,
                                atol=TOLERANCE)
@@ -114,7 +122,7 @@ def test_continuous_systems_held_by_zero_order_hold(tmp_path, kind):
         A = rng.normal(size=(4, 4)) - 3 * np.eye(4)
         system = control.ss(A, rng.normal(size=(4, 2)), rng.normal(size=(3, 4)), rng.normal(size=(3, 2)),
                             name="plant")
-    path = export_fmu(system, tmp_path / "plant.fmu", step=0.01)
+    path = export(system, tmp_path / "plant.fmu", step=0.01)
     u = np.random.default_rng(7).normal(size=(120, system.ninputs))
     for h in (0.01, 0.037):
         discrete = control.c2d(control.ss(system), h, "zoh")
@@ -167,7 +175,7 @@ def test_every_method_alone_behind_a_prefilter_and_in_the_closed_loop(tmp_path, 
     dt = 0.01
     u = imu_stream(150, dt)
     alone = estimator_system(method, dt=dt)
-    path = export_fmu(alone, tmp_path / "alone.fmu")
+    path = export(alone, tmp_path / "alone.fmu")
     np.testing.assert_allclose(fmu_outputs(path, u, dt, alone), reference(alone, u, dt), rtol=0, atol=TOLERANCE)
     links_no_python(path)
     assert validate_fmu(str(path)) == []
@@ -176,14 +184,14 @@ def test_every_method_alone_behind_a_prefilter_and_in_the_closed_loop(tmp_path, 
                                   inplist=[f"prefilter.raw_{s}_{x}" for s in ("gyr", "acc") for x in "xyz"],
                                   outlist=["estimator.ghat_x", "estimator.ghat_y", "estimator.ghat_z",
                                            "estimator.q_w", "estimator.q_x", "estimator.q_y", "estimator.q_z"])
-    path = export_fmu(behind, tmp_path / "behind.fmu")
+    path = export(behind, tmp_path / "behind.fmu")
     np.testing.assert_allclose(fmu_outputs(path, u, dt, behind), reference(behind, u, dt), rtol=0, atol=TOLERANCE)
     assert validate_fmu(str(path)) == []
 
     diagram, x0 = closed_loop(HumanMotion(), ImuModel(), 1.0 / dt, method)
     n = 120
     noise = np.hstack([normals(4, MOTION, n), normals(4, SENSOR, n)])
-    path = export_fmu(diagram, tmp_path / "loop.fmu", x0=x0, fmi_version="3.0" if method == "wiener" else "2.0")
+    path = export(diagram, tmp_path / "loop.fmu", x0=x0, fmi_version="3.0" if method == "wiener" else "2.0")
     np.testing.assert_allclose(fmu_outputs(path, noise, dt, diagram), reference(diagram, noise, dt, x0), rtol=0,
                                atol=TOLERANCE)
     links_no_python(path)
@@ -290,7 +298,7 @@ def test_fmu_states_come_back_and_forged_ones_are_refused(tmp_path):
         [profile("coning").motion().system(fs), ImuModel().system(fs), estimator_system("tseng", dt=1 / fs),
          attitude_error_system(fs)], inplist=[f"{s}_{a}" for s in ("n", "na") for a in "xyz"],
         outlist=["incl_err", "q_w", "q_x", "q_y", "q_z"], name="coning")
-    path = export_fmu(diagram, tmp_path / "coning.fmu")
+    path = export(diagram, tmp_path / "coning.fmu")
     md = read_model_description(str(path))
     refs = {v.name: v.valueReference for v in md.modelVariables}
     fmu = FMU2Slave(guid=md.guid, unzipDirectory=extract(str(path)), modelIdentifier="coning", instanceName="state")

@@ -2,7 +2,7 @@
 (CMake, through tests/native.py), run over the golden streams, the refusals and the simulation
 again, and through the FMU-state, count and step refusals of tests/test_fmu_state.py: the same
 results, and no report of an out-of-bounds access, a use of freed or uninitialised memory or
-undefined behaviour."""
+undefined behaviour; and diagrams exported by export_fmu, built with the sanitizers."""
 import pytest
 
 from tests import native
@@ -30,3 +30,10 @@ def test_the_golden_streams_refusals_and_simulation_run_clean_on_the_sanitized_b
 
 def test_the_fmu_state_refusals_run_clean_on_the_sanitized_build():
     assert_clean("tests/test_fmu_state.py")
+
+
+def test_exported_diagrams_run_clean_on_the_sanitized_build():
+    """Exported diagrams' generated C (fmu_src/diagram, models/Diagram.c) built with the sanitizers: random
+    state spaces, continuous ones across a change of step, wiener alone, behind a prefilter and in the
+    closed loop, FMU states and forged ones."""
+    assert_clean("tests/test_export.py", "-k", "random or continuous or wiener or states")

@@ -23,7 +23,7 @@ def _model_name(system, name: str | None) -> str:
 
 def export_fmu(system, path, *, x0=None, step: float | None = None, fmi_version: str = "2.0",
                platforms: str = "host", name: str | None = None, backend: str = "native",
-               log=lambda message: None) -> Path:
+               cmake_options=(), log=lambda message: None) -> Path:
     """system (a python-control system) as a co-simulation FMU written to path; returns its path.
 
     system: a control.StateSpace or TransferFunction (SISO or MIMO; discrete ones step at their dt,
@@ -40,7 +40,8 @@ def export_fmu(system, path, *, x0=None, step: float | None = None, fmi_version:
     (systems.fmi.platforms; needs the `platforms` extra); name: the model identifier (default the
     system's name); backend: "native" (C, no Python at run time) or "python" (pythonfmu: any discrete
     system, Python functions included; the FMU needs a Python with attitude_fmu and control where it
-    runs); log: progress messages.
+    runs); cmake_options: more -D options of the native build (NAME=VALUE: AF_WERROR=ON, warnings as
+    errors; AF_SANITIZE=ON, the address and undefined-behaviour sanitizers); log: progress messages.
     ExportError names a block that cannot be exported natively (a Python-function block, an
     algebraic loop) and why; ValueError for bad arguments."""
     from attitude_fmu.systems.fmi.platforms import parse_platforms
@@ -74,7 +75,7 @@ def export_fmu(system, path, *, x0=None, step: float | None = None, fmi_version:
                    f"block(s) in C ({', '.join(sorted({b.kind for b in diagram.blocks}))}), "
                    + (f"sample time {diagram.dt!r} s" if diagram.dt else "continuous, held by zero-order hold"))
     return write_native(path, model, fmi_version, diagram, x0, step or diagram.dt or 0.01, description,
-                        parse_platforms(platforms), log)
+                        parse_platforms(platforms), tuple(cmake_options), log)
 
 
 __all__ = ["ExportError", "export_fmu"]

@@ -58,15 +58,16 @@ def stage_files(name: str, fmi: str, diagram, x0, step: float | None, descriptio
                            step)
 
 
-def build_binary(stage: Path, name: str, fmi: str, platform: str | None, build_dir: Path) -> None:
-    """The binary of the staged FMU built into stage/binaries/ by CMake in build_dir: for this platform
-    (platform None) or another (an FMI 3.0 tuple of systems.fmi.platforms.PLATFORMS, with zig's compiler)."""
+def build_binary(stage: Path, name: str, fmi: str, platform: str | None, build_dir: Path, options=()) -> None:
+    """The binary of the staged FMU built into stage/binaries/ by CMake in build_dir (with the -D options):
+    for this platform (platform None) or another (an FMI 3.0 tuple of systems.fmi.platforms.PLATFORMS,
+    with zig's compiler)."""
     from attitude_fmu.build_fmu import cmake_build, project_version
     from attitude_fmu.systems.fmi.platforms import PLATFORMS, TOOLCHAIN
 
     root = _package_root()
     options = [f"AF_EXPORT={stage}", f"AF_EXPORT_NAME={name}", f"AF_EXPORT_FMI={fmi}", "AF_PYTHON=OFF",
-               "AF_FMUS=OFF", f"AF_VERSION={project_version()}"]
+               "AF_FMUS=OFF", f"AF_VERSION={project_version()}", *options]
     if platform is not None:
         options += [f"CMAKE_TOOLCHAIN_FILE={root / TOOLCHAIN}", f"AF_ZIG_TARGET={PLATFORMS[platform][0]}"]
     cmake_build(build_dir, ["af_export"], options, source=root, quiet=True)
@@ -84,10 +85,10 @@ def zip_folder(folder: Path, path: Path) -> None:
     os.replace(partial, path)
 
 
-def write_native(path: Path, name: str, fmi: str, diagram, x0, step, description: str, platforms,
+def write_native(path: Path, name: str, fmi: str, diagram, x0, step, description: str, platforms, options=(),
                  log=lambda message: None) -> Path:
-    """The native FMU of the diagram written to path, with the binaries of this platform and the
-    platforms (FMI 3.0 tuples; FMI 2.0: those with an FMI 2.0 folder)."""
+    """The native FMU of the diagram written to path, with the binaries of this platform and the platforms
+    (FMI 3.0 tuples; FMI 2.0: those with an FMI 2.0 folder), each built with the -D options."""
     from attitude_fmu.fmu_src.generate import write_stage
     from attitude_fmu.systems.fmi.platforms import LIBRARY_SUFFIXES, PLATFORMS
 
@@ -98,7 +99,7 @@ def write_native(path: Path, name: str, fmi: str, diagram, x0, step, description
         for platform in targets:
             log(f"{name}.fmu: building its binary for {platform or 'this platform'}")
             try:
-                build_binary(stage, name, fmi, platform, Path(tmp) / f"build-{platform or 'host'}")
+                build_binary(stage, name, fmi, platform, Path(tmp) / f"build-{platform or 'host'}", options)
             except subprocess.CalledProcessError as exc:
                 raise ExportError(f"building {name}.fmu for {platform or 'this platform'} failed:\n"
                                   f"{(exc.stdout or '')[-3000:]}{(exc.stderr or '')[-3000:]}") from exc
