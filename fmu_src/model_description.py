@@ -43,9 +43,11 @@ LOG_CATEGORIES = {
 
 def start_text(variable) -> str:
     """A start value as the model description writes it: Reals exactly (shortest round trip,
-    NaN as XML Schema spells it), Booleans true/false, Enumerations by their value."""
+    NaN as XML Schema spells it; an array's elements separated by spaces), Booleans true/false,
+    Enumerations by their value."""
     if variable.type == REAL:
-        return "NaN" if math.isnan(variable.start) else repr(float(variable.start))
+        values = variable.start if variable.dimensions else (variable.start,)
+        return " ".join("NaN" if math.isnan(x) else repr(float(x)) for x in values)
     if variable.type == BOOLEAN:
         return "true" if variable.start else "false"
     return str(variable.start)
@@ -111,8 +113,11 @@ def type_definitions(variables) -> Element:
 
 
 def model_variables(variables) -> Element:
+    """FMI 2.0's ModelVariables of the table (scalars only: FMI 2.0 has no arrays)."""
     node = Element("ModelVariables")
     for v in variables:
+        if v.dimensions:
+            raise ValueError(f"{v.name}: FMI 2.0 has no array variables (give its elements as scalars)")
         attributes = {"name": v.name, "valueReference": str(v.value_reference), "description": v.description,
                       "causality": v.causality, "variability": v.variability}
         if v.initial is not None:
@@ -180,7 +185,8 @@ FMI3_TYPES = {REAL: "Float64", INTEGER: "Int32"}  # the table's types that FMI 3
 
 def time_variable(variables) -> Variable:
     """FMI 3.0's independent variable, after the table's variables."""
-    return Variable("time", REAL, "independent", "continuous", 0.0, "simulation time", len(variables), "s")
+    return Variable("time", REAL, "independent", "continuous", 0.0, "simulation time",
+                    sum(v.size for v in variables), "s")
 
 
 def type_definitions3(variables) -> Element:
@@ -200,7 +206,7 @@ def type_definitions3(variables) -> Element:
 def model_variables3(variables) -> Element:
     """FMI 3.0's ModelVariables of the table: Real as Float64, Integer as Int32, Boolean, String
     and Enumeration as themselves, with the same names, value references, causalities, units,
-    declared types and start values, and `time` after them."""
+    declared types and start values, an array with its Dimensions, and `time` after them."""
     node = Element("ModelVariables")
     for v in (*variables, time_variable(variables)):
         attributes = {"name": v.name, "valueReference": str(v.value_reference), "description": v.description,
@@ -218,6 +224,8 @@ def model_variables3(variables) -> Element:
         typed = SubElement(node, FMI3_TYPES.get(v.type, v.type), attributes)
         if v.type == STRING:
             SubElement(typed, "Start", value=start_text(v))
+        for extent in v.dimensions:
+            SubElement(typed, "Dimension", start=str(extent))
     return node
 
 

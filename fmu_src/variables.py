@@ -10,6 +10,8 @@ references. Only the standard library is imported (and blocks/tuning.py): the bu
 """
 from __future__ import annotations
 
+import itertools
+import math
 from dataclasses import dataclass
 from functools import cache
 
@@ -60,7 +62,10 @@ class Variable:
     """One FMI variable. type: REAL, INTEGER, BOOLEAN, STRING or ENUMERATION; causality: IN, OUT
     or PAR; variability and initial as FMI 2.0 spells them (initial None: not stated); unit: an
     FMI unit name of UNITS (Real only); items: an Enumeration's item names, whose values are
-    1, 2, …, n in that order (its start is one of those values)."""
+    1, 2, …, n in that order (its start is one of those values); dimensions: an FMI 3.0 array's
+    (a Real of size values, start a tuple of them, row-major; its elements hold the value
+    references value_reference … value_reference + size − 1 within the FMU, as scalars
+    name[i,j] do in FMI 2.0)."""
 
     name: str
     type: str
@@ -72,6 +77,19 @@ class Variable:
     unit: str | None = None
     initial: str | None = None
     items: tuple[str, ...] = ()
+    dimensions: tuple[int, ...] = ()
+
+    @property
+    def size(self) -> int:
+        """The values it holds: 1, or an array's elements."""
+        return math.prod(self.dimensions)
+
+    def elements(self) -> list[tuple[str, float]]:
+        """An array's elements as scalars: (name[i,j], start) row by row; a scalar's itself."""
+        if not self.dimensions:
+            return [(self.name, self.start)]
+        return [(f"{self.name}[{','.join(map(str, index))}]", value)
+                for index, value in zip(itertools.product(*map(range, self.dimensions)), self.start)]
 
     @property
     def declared_type(self) -> str:
@@ -106,11 +124,14 @@ class Table(list):
     its rows and returns them."""
 
     def add(self, name, type_, causality, variability, start, description, unit=None, initial=None,
-            items=()) -> list[Variable]:
+            items=(), dimensions=()) -> list[Variable]:
+        """A row; its value reference the next free one (an array holds one per element)."""
         if unit is not None and unit not in UNITS:
             raise ValueError(f"unit {unit!r} has no definition in fmu_src.variables.UNITS")
-        self.append(Variable(name, type_, causality, variability, start, description, len(self), unit, initial,
-                             tuple(items)))
+        if dimensions and (type_ != REAL or len(start) != math.prod(dimensions)):
+            raise ValueError(f"{name}: an array is a Real with a start value per element")
+        self.append(Variable(name, type_, causality, variability, start, description,
+                             sum(v.size for v in self), unit, initial, tuple(items), tuple(dimensions)))
         return self[-1:]
 
     def real(self, name, start, unit, description, causality) -> list[Variable]:

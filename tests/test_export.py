@@ -332,3 +332,50 @@ def test_fmu_states_come_back_and_forged_ones_are_refused(tmp_path):
         assert np.array_equal(steps(20, 10), first)
     fmu.terminate()
     fmu.freeInstance()
+
+
+@pytest.mark.parametrize("fmi", ["2.0", "3.0"])
+def test_the_matrices_are_parameters_set_before_initialisation(tmp_path, fmi):
+    """A state space's A, B, C, D: FMI 2.0 scalars A[i,j], FMI 3.0 arrays with their dimensions, both with
+    the exported values as start; set before initialisation, the FMU steps the state space they make."""
+    from fmpy.fmi3 import FMU3Slave
+
+    dt = 0.05
+    system = stable_discrete(11, 3, 2, 2, True, dt)
+    path = export(system, tmp_path / "random.fmu", fmi_version=fmi)
+    md = read_model_description(str(path))
+    variables = {v.name: v for v in md.modelVariables}
+    if fmi == "3.0":
+        assert [int(d.start) for d in variables["A"].dimensions] == [3, 3]
+        assert "A[0,0]" not in variables
+    else:
+        assert float(variables["A[1,2]"].start) == system.A[1, 2] and "A" not in variables
+    other = stable_discrete(12, 3, 2, 2, True, dt)
+    slave = (FMU3Slave if fmi == "3.0" else FMU2Slave)(
+        guid=md.instantiationToken if fmi == "3.0" else md.guid, unzipDirectory=extract(str(path)),
+        modelIdentifier="random", instanceName="matrices")
+    slave.instantiate()
+    if fmi == "2.0":
+        slave.setupExperiment(startTime=0.0)
+    slave.enterInitializationMode()
+    for matrix in "ABCD":
+        values = np.asarray(getattr(other, matrix))
+        if fmi == "3.0":
+            slave.setFloat64([variables[matrix].valueReference], list(values.ravel()))  # nValues: its size
+        else:
+            slave.setReal([variables[f"{matrix}[{i},{j}]"].valueReference for i in range(values.shape[0])
+                           for j in range(values.shape[1])], list(values.ravel()))
+    slave.exitInitializationMode()
+    set_real, get_real = (slave.setFloat64, slave.getFloat64) if fmi == "3.0" else (slave.setReal, slave.getReal)
+    u = np.random.default_rng(13).normal(size=(30, 2))
+    out = []
+    for k, row in enumerate(u):
+        set_real([variables[n].valueReference for n in system.input_labels], list(row))
+        slave.doStep(k * dt, dt)
+        out.append(get_real([variables[n].valueReference for n in system.output_labels]))
+    if fmi == "3.0":
+        got = slave.getFloat64([variables["B"].valueReference], nValues=6)
+        assert np.array_equal(got, np.asarray(other.B).ravel())
+    slave.terminate()
+    slave.freeInstance()
+    np.testing.assert_allclose(np.array(out), reference(other, u, dt), rtol=0, atol=TOLERANCE)

@@ -40,6 +40,9 @@ typedef struct {
     const char *start_string; /* the start value of a String; NULL for the other types */
     const char *const *items; /* an Enumeration's item names, of the values 1 ... n_items; NULL for the others */
     size_t n_items;
+    size_t fmi3_count;        /* the values FMI 3.0 gets and sets at its value reference: 1 for a scalar; an FMI 3.0
+                                 array's size at its first element (its elements are the variables of the value
+                                 references that follow), 0 at its other elements (no variable of FMI 3.0's) */
 } Fmi2Variable;
 
 typedef struct Fmi2Instance Fmi2Instance;

@@ -4,7 +4,8 @@
  * complete"), Terminated and the error state), does it through the plumbing, and returns the status
  * the standard gives it, raised to what the call logged. A call without an instance (NULL) returns
  * fmi3Error: there is no logger to tell. The variables are the model's (Float64, Int32, Int64, Boolean and
- * String: its Real, Integer, Enumeration, Boolean and String ones) and `time`, the independent variable. */
+ * String: its Real, Integer, Enumeration, Boolean and String ones; a Float64 array holds its elements'
+ * values, Fmi2Variable.fmi3_count) and `time`, the independent variable. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -160,14 +161,55 @@ static int counts_match(Fmi2Instance *instance, const char *call, size_t nvr, si
     return 0;
 }
 
+/* the values of a Float64 value reference: time's 1, a variable's its fmi3_count (an array's elements), 0 for
+ * none (refused where it is read) */
+static size_t float64_count(fmi3ValueReference vr) {
+    if (vr == FMI3_TIME_VR) return 1;
+    return vr < fmi2_model.n_variables ? fmi2_model.variables[vr].fmi3_count : 1;
+}
+
+/* counts_match for Float64, whose arrays hold several values: n_values the values of the nvr value references
+ * together (float64_count), a value reference that is none of a variable's first counting as one, to be
+ * refused by name where it is read */
+static int float64_counts_match(Fmi2Instance *instance, const char *call, size_t nvr, size_t n_values,
+                                const fmi3ValueReference *vr, const void *values) {
+    size_t total = 0;
+    if (nvr > MAX_COUNT || n_values > MAX_COUNT || (nvr > 0 && !vr))
+        return counts_match(instance, call, nvr, n_values, vr, values);
+    for (size_t i = 0; i < nvr; i++) {
+        size_t count = float64_count(vr[i]);
+        total += count ? count : 1;
+    }
+    if (total == n_values) return counts_match(instance, call, n_values, n_values, vr, values);
+    fmi2_log(instance, fmi2Error, "%s: %lu values for %lu value references, which hold %lu", call,
+             (unsigned long)n_values, (unsigned long)nvr, (unsigned long)total);
+    return 0;
+}
+
+/* a value reference that names no FMI 3.0 variable (an array's element other than its first): refused */
+static int is_element(Fmi2Instance *instance, const char *call, fmi3ValueReference vr) {
+    if (float64_count(vr) != 0) return 0;
+    fmi2_log(instance, fmi2Error, "%s: value reference %lu is no variable of this FMU (an element of the array "
+             "before it)", call, (unsigned long)vr);
+    return 1;
+}
+
 fmi3Status fmi3GetFloat64(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, fmi3Float64 values[],
                           size_t nValues) {
     INSTANCE(c, "fmi3GetFloat64", GETTABLE);
-    if (!counts_match(instance, "fmi3GetFloat64", nvr, nValues, vr, values)) return leave(instance, fmi2Error);
-    for (size_t i = 0; i < nvr; i++) {
-        if (vr[i] == FMI3_TIME_VR) values[i] = instance->time;
-        else if (fmi2_get_values(instance, "fmi3GetFloat64", FMI2_TYPES(FMI2_REAL), &vr[i], 1, &values[i]) != fmi2OK)
-            return leave(instance, fmi2Error);
+    if (!float64_counts_match(instance, "fmi3GetFloat64", nvr, nValues, vr, values))
+        return leave(instance, fmi2Error);
+    for (size_t i = 0, k = 0; i < nvr; i++) {
+        if (vr[i] == FMI3_TIME_VR) {
+            values[k++] = instance->time;
+            continue;
+        }
+        if (is_element(instance, "fmi3GetFloat64", vr[i])) return leave(instance, fmi2Error);
+        for (size_t e = 0, count = float64_count(vr[i]); e < count; e++, k++) {
+            const fmi2ValueReference element = (fmi2ValueReference)(vr[i] + e);
+            if (fmi2_get_values(instance, "fmi3GetFloat64", FMI2_TYPES(FMI2_REAL), &element, 1, &values[k]) != fmi2OK)
+                return leave(instance, fmi2Error);
+        }
     }
     return leave(instance, fmi2OK);
 }
@@ -175,13 +217,28 @@ fmi3Status fmi3GetFloat64(fmi3Instance c, const fmi3ValueReference vr[], size_t 
 fmi3Status fmi3SetFloat64(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, const fmi3Float64 values[],
                           size_t nValues) {
     INSTANCE(c, "fmi3SetFloat64", SETTABLE);
-    if (!counts_match(instance, "fmi3SetFloat64", nvr, nValues, vr, values)) return leave(instance, fmi2Error);
-    for (size_t i = 0; i < nvr; i++)
+    if (!float64_counts_match(instance, "fmi3SetFloat64", nvr, nValues, vr, values))
+        return leave(instance, fmi2Error);
+    for (size_t i = 0; i < nvr; i++) {
         if (vr[i] == FMI3_TIME_VR) {
             fmi2_log(instance, fmi2Error, "fmi3SetFloat64: time is the independent variable: it cannot be set");
             return leave(instance, fmi2Error);
         }
-    return leave(instance, fmi2_set_values(instance, "fmi3SetFloat64", FMI2_TYPES(FMI2_REAL), vr, nvr, values));
+        if (is_element(instance, "fmi3SetFloat64", vr[i])) return leave(instance, fmi2Error);
+    }
+    if (nValues == nvr) /* scalars only: one call, every value checked before any is set */
+        return leave(instance, fmi2_set_values(instance, "fmi3SetFloat64", FMI2_TYPES(FMI2_REAL), vr, nvr, values));
+    /* arrays: their elements' value references, nValues of them, then one call likewise */
+    fmi2ValueReference *elements = malloc(nValues * sizeof *elements);
+    if (!elements) {
+        fmi2_log(instance, fmi2Error, "fmi3SetFloat64: no memory for %lu values", (unsigned long)nValues);
+        return leave(instance, fmi2Error);
+    }
+    for (size_t i = 0, k = 0; i < nvr; i++)
+        for (size_t e = 0, count = float64_count(vr[i]); e < count; e++) elements[k++] = (fmi2ValueReference)(vr[i] + e);
+    fmi2Status status = fmi2_set_values(instance, "fmi3SetFloat64", FMI2_TYPES(FMI2_REAL), elements, nValues, values);
+    free(elements);
+    return leave(instance, status);
 }
 
 fmi3Status fmi3GetString(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, fmi3String values[],

@@ -32,7 +32,9 @@ def export_fmu(system, path, *, x0=None, step: float | None = None, fmi_version:
     HumanMotion.system, ClosedForm.system, magnetometer_system, attitude_error_system), or a
     control.interconnect of these, nested to any depth. After the doStep that ends at t[k+1], with
     the inputs of sample k held over it, the outputs are the system's outputs at sample k as
-    control.input_output_response computes them.
+    control.input_output_response computes them. A state space's matrices are parameters, changeable
+    before initialisation (FMI 3.0: an array each, A; FMI 2.0: a scalar each, A[0,1]; inside a diagram
+    prefixed by the block's path, block.A).
     x0: the initial state (python-control's state vector; None: zeros, which for the project's
     blocks means at rest on the first sample); step: the DefaultExperiment's step (s; default the
     system's dt, 0.01 s for a continuous one); a discrete system refuses another communication step;

@@ -51,7 +51,7 @@ def stage_files(name: str, fmi: str, diagram, x0, step: float | None, descriptio
     from attitude_fmu.fmu_src.generate import NativeModel, generated_files
     from attitude_fmu.systems.fmi.export.tables import tables_header, variables
 
-    table, first = variables(diagram)
+    table, first = variables(diagram, fmi)
     sources = source_files(fmi)
     sources["diagram_tables.h"] = tables_header(name, diagram, first, x0).encode("ascii")
     return generated_files(name, fmi, project_version(), sources, NativeModel(lambda: table, description, EXPORTED),

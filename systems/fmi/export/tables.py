@@ -30,10 +30,11 @@ def matrix_names(prefix: str, matrix: str, shape) -> list[str]:
     return [f"{prefix}{matrix}[{i},{j}]" for i in range(shape[0]) for j in range(shape[1])]
 
 
-def variables(diagram) -> tuple[list, dict[int, int]]:
+def variables(diagram, fmi: str = "2.0") -> tuple[list, dict[int, int]]:
     """(the FMU's variables: the diagram's inputs, its outputs, then each state space's matrices as
-    parameters; the value reference of each state-space block's A[0,0], by block index). ValueError
-    where two variables would have the same name."""
+    parameters, FMI 2.0: one scalar each (A[0,0], …), FMI 3.0: an array each (A, its Dimensions);
+    the value reference of each state-space block's first matrix element, by block index).
+    ValueError where two variables would have the same name."""
     system, table, first = diagram.system, Table(), {}
     for label in system.input_labels:
         table.real(label, 0.0, signal_unit(label), f"input {label}", IN)
@@ -45,17 +46,21 @@ def variables(diagram) -> tuple[list, dict[int, int]]:
         if block.n_states + block.n_inputs > LTI_MAX:
             raise ValueError(f"block {block.path or system.name!r}: {block.n_states} states and {block.n_inputs} "
                              f"inputs; an exported state space takes {LTI_MAX} of them at most together")
-        first[index] = len(table)
+        first[index] = sum(v.size for v in table)
         prefix = f"{block.path}." if block.path else ""
+        kind = "continuous" if diagram.dt == 0 else f"discrete (dt = {diagram.dt!r} s)"
         for matrix in MATRICES:
-            values = np.atleast_2d(np.asarray(getattr(block.lti, matrix), dtype=float))
             shape = (block.n_states if matrix in "AB" else block.n_outputs,
                      block.n_states if matrix in "AC" else block.n_inputs)
+            values = np.asarray(getattr(block.lti, matrix), dtype=float)
             values = values.reshape(shape) if values.size else np.zeros(shape)
-            kind = "continuous" if diagram.dt == 0 else f"discrete (dt = {diagram.dt!r} s)"
-            for name, value in zip(matrix_names(prefix, matrix, shape), values.ravel()):
-                table.add(name, REAL, PAR, "fixed", float(value), f"{kind} state-space matrix {matrix} of "
-                          f"{block.path or system.name}")
+            description = f"{kind} state-space matrix {matrix} of {block.path or system.name}"
+            if fmi == "3.0" and values.size:
+                table.add(f"{prefix}{matrix}", REAL, PAR, "fixed", tuple(map(float, values.ravel())),
+                          f"{description}, {shape[0]}×{shape[1]}, row-major", dimensions=shape)
+            elif fmi != "3.0":
+                for name, value in zip(matrix_names(prefix, matrix, shape), values.ravel()):
+                    table.add(name, REAL, PAR, "fixed", float(value), description)
     names = [v.name for v in table]
     repeated = sorted({n for n in names if names.count(n) > 1})
     if repeated:
