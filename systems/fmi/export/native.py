@@ -97,7 +97,7 @@ def write_native(path: Path, name: str, fmi: str, diagram, x0, step, description
         write_stage(stage, stage_files(name, fmi, diagram, x0, step, description))
         targets = [None] + [p for p in platforms if fmi == "3.0" or PLATFORMS[p][1] is not None]
         for platform in targets:
-            log(f"{name}.fmu: building its binary for {platform or 'this platform'}")
+            log(f"{Path(path).name} (model {name}): building its binary for {platform or 'this platform'}")
             try:
                 build_binary(stage, name, fmi, platform, Path(tmp) / f"build-{platform or 'host'}", options)
             except subprocess.CalledProcessError as exc:
