@@ -96,7 +96,8 @@ static int given_params(const DiagramBlock *b, int skip_nan, AfGiven given[AF_N_
     return 0;
 }
 
-/* the entry k of the LTI block's matrices A, B, C, D (laid out from the Real at its parameter) as "C[1, 0]" */
+/* the entry k of the LTI block's matrices A, B, C, D (laid out from the Real at its parameter) as "C[1,0]", the
+ * name of its FMI 2.0 variable */
 static const char *lti_entry(const LtiCoef *c, size_t k, char *out, size_t size)
 {
     const size_t offsets[4] = {0, c->n * c->n, c->n * c->n + c->n * c->m, c->n * c->n + c->n * c->m + c->p * c->n};
@@ -104,7 +105,7 @@ static const char *lti_entry(const LtiCoef *c, size_t k, char *out, size_t size)
     int matrix = 3;
     while (k < offsets[matrix]) matrix--;
     k -= offsets[matrix];
-    snprintf(out, size, "%c[%lu, %lu]", "ABCD"[matrix], (unsigned long)(k / columns[matrix]),
+    snprintf(out, size, "%c[%lu,%lu]", "ABCD"[matrix], (unsigned long)(k / columns[matrix]),
              (unsigned long)(k % columns[matrix]));
     return out;
 }
