@@ -57,6 +57,11 @@ def fmi_unit(unit: str) -> str:
     return name
 
 
+def element_names(name: str, dimensions) -> list[str]:
+    """The names of an array's elements, row by row, 0-based as numpy: A[0,0], A[0,1], …"""
+    return [f"{name}[{','.join(map(str, index))}]" for index in itertools.product(*map(range, dimensions))]
+
+
 @dataclass(frozen=True)
 class Variable:
     """One FMI variable. type: REAL, INTEGER, BOOLEAN, STRING or ENUMERATION; causality: IN, OUT
@@ -88,8 +93,7 @@ class Variable:
         """An array's elements as scalars: (name[i,j], start) row by row; a scalar's itself."""
         if not self.dimensions:
             return [(self.name, self.start)]
-        return [(f"{self.name}[{','.join(map(str, index))}]", value)
-                for index, value in zip(itertools.product(*map(range, self.dimensions)), self.start)]
+        return list(zip(element_names(self.name, self.dimensions), self.start))
 
     @property
     def declared_type(self) -> str:

@@ -10,6 +10,7 @@
 #include "errors.h"
 #include "messages.h"
 #include "profile_params.h"
+#include "stages/fields.h"
 #include "stages/timing.h"
 
 #define MAX_SAMPLES 9007199254740992.0 /* 2^53: the sample counts a double holds exactly */
@@ -42,13 +43,6 @@ const char *kind_name(DiagramKind kind)
     return (int)kind >= 0 && kind < DIAGRAM_KINDS ? KIND_NAMES[kind] : "unknown";
 }
 
-static int all_finite(const double *values, size_t n)
-{
-    for (size_t i = 0; i < n; i++)
-        if (!isfinite(values[i])) return 0;
-    return 1;
-}
-
 static int all_zero(const double *values, size_t n)
 {
     for (size_t i = 0; i < n; i++)
@@ -73,7 +67,7 @@ static int check_numbers(const DiagramBlock *b, size_t n, int finite, char *mess
     if (b->n_numbers != n || (n > 0 && b->numbers == NULL))
         return refuse(message, size, "a %s block takes %lu numbers, the diagram gives it %lu", KIND_NAMES[b->kind],
                       (unsigned long)n, (unsigned long)(b->numbers == NULL ? 0 : b->n_numbers));
-    if (finite && !all_finite(b->numbers, n))
+    if (finite && !af_finite(b->numbers, n * sizeof(double), NULL))
         return refuse(message, size, "its numbers must be finite");
     return 0;
 }
@@ -377,7 +371,7 @@ void kind_step(const DiagramBlock *b, const KindCoef *c, const LtiMatrices *lti,
 int kind_validate(const DiagramBlock *b, const KindCoef *c, const double *state, char *message, size_t size)
 {
     char value[FLOAT_REPR_SIZE];
-    if (!all_finite(state, b->n_states)) return refuse(message, size, "its state holds values that are not finite");
+    if (!af_finite(state, b->n_states * sizeof(double), NULL)) return refuse(message, size, "its state holds values that are not finite");
     if ((b->kind == DIAGRAM_METHOD || b->kind == DIAGRAM_FILTER) && !all_zero(state, b->n_states) &&
         !stepper_state_valid(&c->stepper, state))
         return refuse(message, size, "its state's quaternion is not a unit one");

@@ -56,6 +56,8 @@ def export_fmu(system, path, *, x0=None, step: float | None = None, fmi_version:
     path = Path(path)
     if path.suffix != ".fmu":
         raise ValueError(f"the FMU's path must end in .fmu, got {str(path)!r}")
+    if not path.parent.is_dir():
+        raise ValueError(f"cannot write {path}: no folder {path.parent}")
     if step is not None and not (isinstance(step, (int, float)) and math.isfinite(step) and step > 0):
         raise ValueError(f"step must be a finite positive number of seconds, got {step!r}")
     nstates = system.nstates if hasattr(system, "nstates") else 0

@@ -7,7 +7,7 @@ import re
 import numpy as np
 
 from attitude_fmu.blocks.core.generate_tables import c_double, c_string
-from attitude_fmu.fmu_src.variables import IN, OUT, PAR, REAL, Table
+from attitude_fmu.fmu_src.variables import IN, OUT, PAR, REAL, Table, element_names
 
 # a signal's unit by its label's stem, as the project's blocks name their signals (FMI unit names)
 UNIT_STEMS = {"gyr": "rad/s", "gyr_raw": "rad/s", "omega": "rad/s", "offset": "rad/s", "acc": "m/s2", "f": "m/s2",
@@ -23,11 +23,6 @@ def signal_unit(label: str) -> str | None:
     """The unit of a signal the project's blocks name (gyr_x: rad/s, q_w: 1, …), None for another."""
     stem = re.sub(r"_[wxyz]$", "", label)
     return UNIT_STEMS.get(stem)
-
-
-def matrix_names(prefix: str, matrix: str, shape) -> list[str]:
-    """The parameters' names of a matrix: prefix + A[0,0], A[0,1], … row by row (0-based, as numpy)."""
-    return [f"{prefix}{matrix}[{i},{j}]" for i in range(shape[0]) for j in range(shape[1])]
 
 
 def variables(diagram, fmi: str = "2.0") -> tuple[list, dict[int, int]]:
@@ -59,7 +54,7 @@ def variables(diagram, fmi: str = "2.0") -> tuple[list, dict[int, int]]:
                 table.add(f"{prefix}{matrix}", REAL, PAR, "fixed", tuple(map(float, values.ravel())),
                           f"{description}, {shape[0]}×{shape[1]}, row-major", dimensions=shape)
             elif fmi != "3.0":
-                for name, value in zip(matrix_names(prefix, matrix, shape), values.ravel()):
+                for name, value in zip(element_names(f"{prefix}{matrix}", shape), values.ravel()):
                     table.add(name, REAL, PAR, "fixed", float(value), description)
     names = [v.name for v in table]
     repeated = sorted({n for n in names if names.count(n) > 1})
