@@ -48,7 +48,7 @@ def cli_reference(parser: argparse.ArgumentParser) -> str:
             if isinstance(action, argparse._HelpAction):
                 continue
             choices = ", ".join(f"`{c}`" for c in action.choices) if action.choices else ""
-            out.append(f"| {_flags(action)} | {choices} | {_default(action)} | {_cell(action.help or '')} |")
+            out.append(f"| {_flags(action)} | {choices} | {_default(action)} | {_cell((action.help or '').replace('%%', '%'))} |")
         if sub.epilog:
             out += ["", "```", sub.epilog.strip(), "```"]
         out.append("")

@@ -340,7 +340,7 @@ def test_table1_json_every_cell_within_7_percent(capsys):
 def test_bench_json_reports_rates_and_ratios(capsys):
     assert main(["bench", "--json", "--samples", "2000", "--repeat", "1"]) == 0
     result = json.loads(capsys.readouterr().out)
-    assert set(result["samples_per_s"]) == {"wiener", "wiener_stationary", "wiener_offset", "wiener_9d",
+    assert set(result["samples_per_s"]) == {"wiener", "wiener_held", "wiener_stationary", "wiener_offset", "wiener_9d",
                                             "vqf", "vqf_9d", "madgwick"}
     assert result["ratio_vs_vqf"]["vqf"] == pytest.approx(1.0)
     assert result["ratio_vs_vqf_9d"]["vqf_9d"] == pytest.approx(1.0)

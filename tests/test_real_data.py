@@ -18,6 +18,7 @@ from attitude_fmu.blocks.filters import earth_filters as ef
 from attitude_fmu.blocks.pipeline.batch import estimate
 from attitude_fmu.blocks.stages.gyro_offset import correct as correct_gyro
 from attitude_fmu.blocks.stages.heading import with_magnetometer
+from attitude_fmu.blocks.stages.scale_error import SCALE_ERRORS
 from attitude_fmu.blocks.stages.timing import interval_means
 from attitude_fmu.systems.cli.commands import main
 from attitude_fmu.systems.evaluation import experiments as ex
@@ -157,21 +158,23 @@ def test_a_short_rest_gives_the_mean_of_its_gyro_samples():
 def test_offset_is_tracked_while_moving_without_rest(size):
     """No rest at all: the accelerometer in the gyro frame pins the offset down (blocks.stages.gyro_offset):
     the tilt error within 15 % of a gyro without offset's (2–4 % at 1 °/s, 7–13 % at 3 °/s over
-    six realisations)."""
+    six realisations). Every estimate holds the same scale_error, so that the batch path's choice
+    of it (blocks.stages.scale_error) does not differ between them."""
     motion = HumanMotion(delta_v=0.25).generate(600.0, FS, seed=1)
+    held = {"scale_error": 0.005}
     gyr, acc = ImuModel(delta_n=math.radians(0.02), acc_noise=0.002).apply(motion, seed=11)
     offset = np.radians([1.0, -1.0, 0.5]) * size
-    est = estimate(gyr + offset, acc, FS, gyro_offset=True)
+    est = estimate(gyr + offset, acc, FS, params=held, gyro_offset=True)
     half = int(300 * FS)
     assert np.degrees(np.abs(est.offset[half:] - offset)).max() < 0.1  # °/s
     error = lambda up: rms(np.degrees(inclination_error(up[half:], motion.up[half:])))
     untracked, _ = correct_gyro(gyr + offset, acc, FS, {"tau_motion": 0.0})
     vqf_up = Rotation.from_quat(peer_quaternions("vqf", gyr + offset, acc, FS), scalar_first=True).inv().apply([0, 0, 1])
     print(f"offset {size} °/s, inclination RMS: tracked {error(est.up):.3f}°, "
-          f"without offset {error(estimate(gyr, acc, FS, gyro_offset=False).up):.3f}°, "
-          f"rest-only estimator {error(estimate(untracked, acc, FS, gyro_offset=False).up):.3f}°, vqf {error(vqf_up):.3f}°")
-    assert error(est.up) < 1.15 * error(estimate(gyr, acc, FS, gyro_offset=False).up)
-    assert error(estimate(untracked, acc, FS, gyro_offset=False).up) > 5 * error(est.up)
+          f"without offset {error(estimate(gyr, acc, FS, params=held, gyro_offset=False).up):.3f}°, "
+          f"rest-only estimator {error(estimate(untracked, acc, FS, params=held, gyro_offset=False).up):.3f}°, vqf {error(vqf_up):.3f}°")
+    assert error(est.up) < 1.15 * error(estimate(gyr, acc, FS, params=held, gyro_offset=False).up)
+    assert error(estimate(untracked, acc, FS, params=held, gyro_offset=False).up) > 5 * error(est.up)
     if size > 2.0:
         assert error(vqf_up) > 5 * error(est.up)
 
@@ -249,7 +252,9 @@ def test_evaluate_json_contract_on_synthetic_recordings(tmp_path, capsys):
         _broad_like(tmp_path / f"{name}.mat", motion)
     assert main(["evaluate", "--json", "--workers", "1", str(tmp_path / "a.mat"), str(tmp_path / "b.mat")]) == 0
     result = json.loads(capsys.readouterr().out)
-    assert set(result) == {"recordings", "mean", "imu_latency_s"} and set(result["recordings"]) == {"a", "b"}
+    assert set(result) == {"recordings", "mean", "imu_latency_s", "chosen"} and set(result["recordings"]) == {"a", "b"}
+    assert set(result["chosen"]) == {"a", "b"}  # each recording's scale_error (blocks.stages.scale_error)
+    assert all(found["scale_error"] in SCALE_ERRORS for found in result["chosen"].values())
     assert all(abs(lag) < 1e-3 for lag in result["imu_latency_s"].values())  # written without a delay (slow turns)
     for table in (result["recordings"]["a"], result["mean"]):
         assert set(table) == {"wiener", "vqf", "vqf_offline", "madgwick", "vqf_9d"}

@@ -115,7 +115,7 @@ def test_every_path_to_a_methods_step_gives_its_frozen_outputs(fmus, case, path)
     elif path in ("fmu", "pythonfmu"):
         out, taken = fmus[path].run(_fmu_start(config, Ts[0]), gyr, acc, mag, Ts)
     elif path == "estimate":
-        est = estimate(gyr, acc, 1.0 / Ts[0], name, given, gyro_offset=False)
+        est = estimate(gyr, acc, 1.0 / Ts[0], name, golden.as_online(name, given), gyro_offset=False)
         out, taken = np.hstack([est.quat, est.up, np.zeros((len(gyr), 10))]), np.ones(len(gyr), dtype=bool)
     else:
         block = estimator_system(name, given, dt=Ts[0])

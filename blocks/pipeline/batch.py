@@ -4,8 +4,8 @@ passes forward and backward in time, and delays measured from the whole recordin
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Mapping
 
 import numpy as np
 
@@ -14,6 +14,7 @@ from attitude_fmu.blocks.methods.registry import METHODS
 from attitude_fmu.blocks.methods.registry import method as get_method
 from attitude_fmu.blocks.pipeline.causal import Pipeline, State, Step, at, configure, run
 from attitude_fmu.blocks.stages import heading as heading_stage
+from attitude_fmu.blocks.stages import scale_error
 from attitude_fmu.blocks.stages.delays import mag_delay
 from attitude_fmu.blocks.stages.gyro_offset import correct as correct_gyro
 from attitude_fmu.blocks.stages.hard_iron import back_dated
@@ -36,6 +37,7 @@ class AttitudeEstimate:
     mag_offset: np.ndarray | None = None  # N×3, µT, hard-iron offset estimate (blocks.stages.hard_iron)
     mag_delay: np.ndarray | None = None  # N, s, the magnetometer's delay behind the gyro the heading allowed for
     mag_delay_source: str | None = None  # "given", "online" (blocks.stages.mag_delay) or "measured" (whole recording)
+    chosen: dict | None = None  # parameters chosen from the recording: {"scale_error": value} (blocks.stages.scale_error)
 
     @property
     def up(self) -> np.ndarray:
@@ -148,11 +150,41 @@ def estimate(
         raise ValueError("acc is zero throughout: no gravity to start on")
     if start:
         gyr, acc, mag = gyr[start:], acc[start:], None if mag is None else mag[start:]
+    chosen = None
+    if scale_error.applies(method, dict(pipeline.params)):
+        found = _chosen_scale_error(pipeline, step, gyr, acc, initial_gravity)
+        if found is not None:
+            chosen = {"scale_error": found}
+            pipeline = check_options(method, {**(params or {}), **chosen}, offline, gyro_offset, mag is not None,
+                                     latency, gyr_samples, acc_samples)
+            step = at(pipeline, 1.0 / fs)
     if offline:
-        return held_before(smoothed(pipeline, step, gyr, acc, mag, initial_gravity), start)
-    rows = run(pipeline, step, State(), gyr, acc, mag, initial_gravity=initial_gravity, threads=threads)
-    return held_before(AttitudeEstimate(rows.gravity, rows.quat, rows.offset, rows.mag_accepted, rows.mag_offset,
-                                        rows.mag_delay, _mag_delay_source(pipeline, offline=False)), start)
+        est = smoothed(pipeline, step, gyr, acc, mag, initial_gravity)
+    else:
+        rows = run(pipeline, step, State(), gyr, acc, mag, initial_gravity=initial_gravity, threads=threads)
+        est = AttitudeEstimate(rows.gravity, rows.quat, rows.offset, rows.mag_accepted, rows.mag_offset,
+                               rows.mag_delay, _mag_delay_source(pipeline, offline=False))
+    est.chosen = chosen
+    return held_before(est, start)
+
+
+def _chosen_scale_error(pipeline: Pipeline, step: Step, gyr, acc, initial_gravity) -> float | None:
+    """blocks.stages.scale_error's choice for the pipeline's method over the rows (None: the
+    recording is too short): the method alone, on the samples as the pipeline turns them
+    (its sample conventions, the gyro freed of its offset by the forward pass)."""
+    fs = 1.0 / step.Ts
+    gyr = interval_means(gyr) if pipeline.point_gyr else gyr
+    acc = interval_ends(gyr, acc, step.Ts) if pipeline.mean_acc else acc
+    if pipeline.offset_params is not None:
+        gyr, _ = correct_gyro(gyr, acc, fs, pipeline.offset_params)
+    own = dict(pipeline.params)
+
+    def gravity(value: float) -> np.ndarray:
+        return estimate(gyr, acc, fs, pipeline.method, {**own, "scale_error": value}, initial_gravity,
+                        gyro_offset=False, threads=1).gravity
+
+    found = scale_error.choose(gyr, acc, fs, gravity)
+    return None if found is None else found[0]
 
 
 def held_before(est: AttitudeEstimate, start: int) -> AttitudeEstimate:

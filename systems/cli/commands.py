@@ -1,4 +1,5 @@
-"""The `attitude` command line: estimate, evaluate, sweep, plot, table1, verify, ssp, compare, bode, bench."""
+"""The `attitude` command line: estimate, evaluate, sweep, plot, table1, verify, ssp, compare, bode, export,
+simulate, bench."""
 from __future__ import annotations
 
 import argparse
@@ -18,6 +19,8 @@ from attitude_fmu.blocks.methods.registry import method as known_method
 from attitude_fmu.blocks.params import GYRO_NOISE, TIME_S
 from attitude_fmu.blocks.pipeline.causal import ESTIMATORS
 from attitude_fmu.blocks.stages.timing import ACC_SAMPLES, GYR_SAMPLES, MAX_LATENCY_S
+from attitude_fmu.systems.cli.simulate import add_parser as add_simulate_parser
+from attitude_fmu.systems.cli.simulate import cmd_simulate
 from attitude_fmu.systems.recordings.checks import RATE_RANGE_HZ
 from attitude_fmu.systems.recordings.output import STDIO, check_output, same_file
 from attitude_fmu.systems.recordings.reading import MAX_GAP_S
@@ -32,6 +35,7 @@ from attitude_fmu.systems.recordings.recording import (
     T_UNITS,
 )
 from attitude_fmu.systems.recordings.writing import output_name
+from attitude_fmu.systems.simulation.recording import MAX_SCALE_ERROR
 
 EXIT_BAD_INPUT = 2
 EXIT_CHECK_FAILED = 1
@@ -47,7 +51,6 @@ MAX_REPEAT = 1000
 MAX_WORKERS = 4096
 MAX_SEED = 2**32 - 1
 MAX_ACC_NOISE = 10.0  # m/s²/√Hz: an accelerometer's white noise, a hundred times a poor MEMS part's
-MAX_SCALE_ERROR = 0.5  # rms scale and misalignment error of the compared gyro (systems.evaluation.compare.imu_model)
 
 
 def _param(text: str) -> tuple[str, float]:
@@ -383,6 +386,8 @@ def build_parser() -> argparse.ArgumentParser:
                     help="native: C, no Python where it runs (default); python: pythonfmu, any discrete system, "
                          "Python functions included (needs a Python with attitude_fmu where it runs)")
 
+    add_simulate_parser(sub, _number, _param)
+
     bn = sub.add_parser("bench", help="samples per second of the batch estimator, vqf and ahrs Madgwick")
     _add_json_flag(bn, "the lines")
     bn.add_argument("--samples", type=_number(MIN_BENCH_SAMPLES, MAX_SAMPLES, whole=True),
@@ -512,6 +517,10 @@ def _estimate_one(args, path, out, prefix: str) -> None:
     if result.offset is not None:
         print(f"attitude: {prefix}gyro offset estimate at the end "
               f"({', '.join(f'{v:.3f}' for v in np.degrees(result.offset[-1]))}) °/s", file=sys.stderr)
+    if result.chosen is not None:
+        from attitude_fmu.blocks.stages.scale_error import chosen_text
+
+        print(f"attitude: {prefix}{chosen_text(result.chosen['scale_error'])}", file=sys.stderr)
     if result.mag_accepted is not None:
         sampled = np.isfinite(rec.mag).all(axis=1)  # rows where a slower magnetometer has a sample
         print(f"attitude: {prefix}magnetometer samples used for heading "
@@ -592,6 +601,12 @@ def cmd_evaluate(args) -> int:
         print(f"{name}: aligned: lag {found['lag_s']:+.4f} s, mounting [w, x, y, z] "
               f"{', '.join(format(c, '.4f') for c in found['mounting_quat'])}, up {found['up_axis']}, heading offset "
               f"{found['heading_offset_deg']:.2f}°, misfit {found['misfit']:.3f}")
+    if "chosen" in result:
+        from attitude_fmu.blocks.stages.scale_error import PREDICTION_HORIZON_S
+
+        print(f"scale_error chosen from each recording (the best prediction of the accelerometer "
+              f"{PREDICTION_HORIZON_S:g} s ahead; --param scale_error=V holds one): "
+              + ", ".join(f"{name} {found['scale_error']:g}" for name, found in result["chosen"].items()))
     return status
 
 
@@ -835,7 +850,8 @@ def main(argv=None) -> int:
         args = build_parser().parse_args(argv)
         handler = {"estimate": cmd_estimate, "evaluate": cmd_evaluate, "sweep": cmd_sweep, "plot": cmd_plot,
                    "table1": cmd_table1, "verify": cmd_verify, "ssp": cmd_ssp, "compare": cmd_compare,
-                   "bode": cmd_bode, "bench": cmd_bench, "export": cmd_export}[args.command]
+                   "bode": cmd_bode, "bench": cmd_bench, "export": cmd_export,
+                   "simulate": lambda a: cmd_simulate(a, _check_out)}[args.command]
         return handler(args)
     except (ValueError, OSError, RuntimeError) as exc:
         print(f"attitude: error: {exc}", file=sys.stderr)

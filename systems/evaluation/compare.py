@@ -13,6 +13,7 @@ from attitude_fmu.blocks.methods.registry import METHODS
 from attitude_fmu.blocks.pipeline.batch import estimate
 from attitude_fmu.systems.cluster.jobs import Failure, Jobs
 from attitude_fmu.systems.simulation.motion import PROFILES
+from attitude_fmu.systems.simulation.recording import Sensor
 from attitude_fmu.systems.simulation.sensor_model import ImuModel
 
 FS = 100.0  # Hz
@@ -26,14 +27,9 @@ def imu_model(gyro_noise_dps: float = 0.02, acc_noise: float = 0.002, gyro_scale
               seed: int = 0) -> ImuModel:
     """The compared IMU: gyro white noise gyro_noise_dps (°/s/√Hz), accelerometer white
     noise acc_noise (m/s²/√Hz) and a scale-factor and misalignment matrix whose elements are
-    drawn normal with rms gyro_scale_error (1 = 100 %) from seed; no offsets."""
-    for what, value, top in (("gyro noise", gyro_noise_dps, math.inf), ("accelerometer noise", acc_noise, math.inf),
-                             ("gyro scale error", gyro_scale_error, 0.5)):
-        if not (math.isfinite(value) and 0.0 <= value < top):
-            raise ValueError(f"{what} must be finite, non-negative{'' if top == math.inf else f' and below {top:g}'}, "
-                             f"got {value!r}")
-    scale = np.random.default_rng((seed, 2)).normal(0.0, gyro_scale_error, (3, 3))
-    return ImuModel(delta_n=math.radians(gyro_noise_dps), acc_noise=acc_noise, gyr_scale=tuple(map(tuple, scale)))
+    drawn normal with rms gyro_scale_error (1 = 100 %) from seed; no offsets
+    (systems.simulation.recording.Sensor)."""
+    return Sensor(gyro_noise_dps, acc_noise, gyro_scale_error, mag_noise=0.0).model(seed)
 
 
 IMU = imu_model()  # a MEMS IMU: gyro 0.02 °/s/√Hz, accelerometer 200 µg/√Hz, ideal scale, no offsets

@@ -104,7 +104,7 @@ def method_label(method: str, offline: bool) -> str:
 def evaluate_recording(rec: Recording, method: str = "wiener", params=None, offline: bool = False,
                        gyro_offset: bool = True, use_mag: bool = True, latency: float = 0.0,
                        peers: bool = True, threads: int | None = None, align: bool = False,
-                       magnetic: bool = False, alignment: dict | None = None) -> dict:
+                       magnetic: bool = False, alignment: dict | None = None, chosen: dict | None = None) -> dict:
     """{method label: {metric: value}} for one recording; with a magnetometer (and use_mag)
     the method's heading comes from it, and vqf's 9D estimate is added as "vqf_9d". A
     reference that fits far better in another order is noted in rec.notes
@@ -116,7 +116,8 @@ def evaluate_recording(rec: Recording, method: str = "wiener", params=None, offl
     lag, mounting, up axis, heading offset), what was found put into the dict alignment when
     given (Alignment.to_json). magnetic: the reference's north is magnetic north, the
     estimate's; else (the default) each estimate's constant heading offset from the reference is
-    removed before its heading error (errors_on_movement)."""
+    removed before its heading error (errors_on_movement). chosen: a dict that receives the
+    parameters the estimate chose from the recording (AttitudeEstimate.chosen), when given."""
     rec.evaluated()  # refuses a recording without a usable reference before any work
     label = method_label(method, offline)
     mag = rec.mag if use_mag else None
@@ -138,6 +139,8 @@ def evaluate_recording(rec: Recording, method: str = "wiener", params=None, offl
     note = None if align else reference_order_note(rec, est.quat)
     if note:
         rec.notes.append(note)
+    if est.chosen is not None and chosen is not None:
+        chosen.update(est.chosen)
     if not peers:
         return {label: errors_on_movement(est.quat, rec, magnetic)}
     import vqf as vqf_module  # peers: the test extra (or [peers])
@@ -200,13 +203,14 @@ def evaluate_file(path, setup: Setup, peers: bool = True) -> dict:
     alone ("table" holds the method's label only, imu_latency_s None), as a sweep needs them."""
     rec = read_prepared(path, setup)
     alignment = {} if setup.align else None
+    chosen = {}
     table = evaluate_recording(rec, setup.method, setup.params, setup.offline, setup.gyro_offset, setup.use_mag,
                                setup.latency, peers, setup.threads, setup.align,
-                               magnetic_north(setup.reference_north), alignment)
+                               magnetic_north(setup.reference_north), alignment, chosen)
     notes = rec.notes + ([f"{rec.name}: no movement flag; errors over every sample with a reference"]
                          if rec.movement is None else [])
     result = {"table": table, "imu_latency_s": imu_latency(rec) if peers and not setup.align else None,
-              "notes": notes}
+              "notes": notes, "chosen": chosen}
     return result if alignment is None else {**result, "alignment": alignment}
 
 
@@ -268,7 +272,8 @@ def evaluate(paths, method: str = "wiener", params=None, offline: bool = False, 
     mounting_quat, up_axis, heading_offset_deg, misfit}}. reference_north: "other" (each
     estimate's constant heading offset from the reference is removed before its heading error)
     or "magnetic" (the reference's north is magnetic north, as BROAD's: kept). by: the means over each group of recordings too, under "by_group"
-    (by_group)."""
+    (by_group). "chosen": {name: {parameter: value}} holds what each estimate chose from its
+    recording (blocks.stages.scale_error), where it chose."""
     jobs = jobs or Jobs(bar=progress)
     setup = Setup(method, params, offline, gyro_offset, use_mag, start_in_movement, read_options, latency,
                   gyr_samples, acc_samples, job_threads(jobs), align, reference_north)
@@ -291,6 +296,9 @@ def evaluate(paths, method: str = "wiener", params=None, offline: bool = False, 
     out = {"recordings": recordings, "mean": mean_over(recordings.values()), "imu_latency_s": lags}
     if align:
         out["alignment"] = {name: result["alignment"] for name, result in done.items()}
+    chosen = {name: result["chosen"] for name, result in done.items() if result.get("chosen")}
+    if chosen:
+        out["chosen"] = chosen
     if by:
         out["by_group"] = by_group(recordings, by)
     failed = {name: result.message for name, result in zip(names, results) if isinstance(result, Failure)}

@@ -1,4 +1,4 @@
-"""Estimates out: the writer (CSV, or Parquet by the file name's suffix) and its columns."""
+"""Estimates and recordings out: the writer (CSV, or Parquet by the file name's suffix) and its columns."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -7,7 +7,13 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from attitude_fmu.systems.recordings.output import replaced
-from attitude_fmu.systems.recordings.recording import PARQUET_SUFFIX
+from attitude_fmu.systems.recordings.recording import (
+    IMU_COLUMNS,
+    MAG_COLUMNS,
+    MOVEMENT_COLUMN,
+    PARQUET_SUFFIX,
+    REF_COLUMNS,
+)
 
 OUTPUT_COLUMNS = ("t", "q_w", "q_x", "q_y", "q_z", "g_x", "g_y", "g_z")
 EULER_COLUMNS = ("roll_deg", "pitch_deg", "yaw_deg")  # with --euler
@@ -56,29 +62,37 @@ def _arrow(values: np.ndarray):
 def write_estimate(path, t, quat, up, euler: bool = False, extra=None) -> None:
     """Columns t,q_w,q_x,q_y,q_z,g_x,g_y,g_z (g the unit up-vector, sensor coordinates);
     euler adds roll, pitch and yaw in degrees (EULER_COLUMNS, euler_degrees); extra
-    ({name: N×3 or N}) adds name_x,name_y,name_z, or the column name, after them. A path
-    ending in PARQUET_SUFFIX gets a Parquet file (float64, every bit), any other a CSV
-    (t with the digits that read back to its every bit, up to 17: epoch time stamps keep
-    their steps; the others CSV_DIGITS significant digits); "-" the CSV on standard output. Written by
-    systems.recordings.output.replaced: complete, or not at all."""
-    import pyarrow as pa
-
-    blocks = [("t", np.asarray(t)[:, None]), (OUTPUT_COLUMNS[1:5], quat), (OUTPUT_COLUMNS[5:], up)]
+    ({name: N×3 or N}) adds name_x,name_y,name_z, or the column name, after them. Written as
+    write_table writes."""
+    blocks = [(("t",), np.asarray(t)[:, None]), (OUTPUT_COLUMNS[1:5], quat), (OUTPUT_COLUMNS[5:], up)]
     if euler:
-        blocks.append((EULER_COLUMNS, None))  # per batch, from quat
+        blocks.append((EULER_COLUMNS, lambda rows: euler_degrees(quat[rows])))
     for name, values in (extra or {}).items():
         values = np.asarray(values)
         blocks.append(((name,), values[:, None]) if values.ndim == 1 else (tuple(f"{name}_{a}" for a in "xyz"), values))
-    names = [n for columns, _ in blocks for n in ((columns,) if isinstance(columns, str) else columns)]
+    write_table(path, blocks)
+
+
+def write_table(path, blocks) -> None:
+    """Columns of floats, t first: blocks is a list of (names, values), values N×len(names) or a
+    function of a slice of rows that gives them for those rows. A path ending in
+    PARQUET_SUFFIX gets a Parquet file (float64, every bit), any other a CSV (the first
+    column with the digits that read back to its every bit, up to 17: epoch time stamps
+    keep their steps; the others CSV_DIGITS significant digits); "-" the CSV on standard
+    output. Written by systems.recordings.output.replaced: complete, or not at all."""
+    import pyarrow as pa
+
+    names = [n for columns, _ in blocks for n in columns]
+    n_rows = len(blocks[0][1])
     parquet = Path(str(path)).suffix.lower() == PARQUET_SUFFIX
     schema = pa.schema([(n, pa.float64()) for n in names])
 
     def batches():
-        for start in range(0, len(t), ROWS_PER_BATCH):
+        for start in range(0, n_rows, ROWS_PER_BATCH):
             rows = slice(start, start + ROWS_PER_BATCH)
             columns = []
             for _, values in blocks:
-                values = euler_degrees(quat[rows]) if values is None else values[rows]
+                values = values(rows) if callable(values) else values[rows]
                 columns += [np.ascontiguousarray(c, dtype=float) for c in values.T]
             yield pa.RecordBatch.from_arrays([_arrow(c if parquet or j == 0 else significant(c))  # 0: t
                                               for j, c in enumerate(columns)], schema=schema)
@@ -98,3 +112,14 @@ def write_estimate(path, t, quat, up, euler: bool = False, extra=None) -> None:
         with pc.CSVWriter(fh, schema, write_options=options) as writer:
             for batch in batches():
                 writer.write_batch(batch)
+
+
+def write_recording(path, rec) -> None:
+    """A recording (systems.recordings.recording.Recording) as the reader reads it back: t,
+    the gyro (rad/s) and accelerometer (m/s²), then where it has them the magnetometer (µT),
+    the reference (REF_COLUMNS) and the movement flag (0 or 1); written as write_table writes."""
+    blocks = [(("t",), np.asarray(rec.t, dtype=float)[:, None]), (IMU_COLUMNS[:3], rec.gyr), (IMU_COLUMNS[3:], rec.acc)]
+    for columns, values in ((MAG_COLUMNS, rec.mag), (REF_COLUMNS, rec.quat_ref), ((MOVEMENT_COLUMN,), rec.movement)):
+        if values is not None:
+            blocks.append((columns, np.asarray(values, dtype=float).reshape(len(rec.t), len(columns))))
+    write_table(path, blocks)

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <nanobind/nanobind.h>
 #include <nanobind/ndarray.h>
@@ -17,6 +18,7 @@ extern "C" {
 #include "stages/delays.h"
 #include "stages/gyro_offset.h"
 #include "stages/heading.h"
+#include "stages/prediction.h"
 #include "stages/timing.h"
 }
 
@@ -279,4 +281,19 @@ void bind_stages(nb::module_ &m)
           "Per span j: matrices[j] = R_Δᵀ, R_Δ the sensor's turn from the fractional sample index x0[j] to\n"
           "x1[j] (held within the recording); quat (N×4): the sensor at t_k integrated from gyr (N×3, rad/s,\n"
           "over Ts s each).");
+    m.def("prediction_error", [](const Rows3 &gyr, const Rows3 &acc, const Rows3 &gravity, double Ts, size_t horizon) {
+        size_t n = gyr.shape(0);
+        check_rows(acc.shape(0), n, "acc");
+        check_rows(gravity.shape(0), n, "gravity");
+        if (!(std::isfinite(Ts) && Ts > 0.0)) throw nb::value_error("Ts must be a finite positive number of seconds");
+        if (horizon < 1 || horizon >= n)
+            throw nb::value_error(("the horizon must be 1 to " + std::to_string(n) + " - 1 samples, got " +
+                                   std::to_string(horizon)).c_str());
+        std::vector<double> work(3 * horizon);
+        nb::gil_scoped_release unlocked;
+        return prediction_error(n, gyr.data(), acc.data(), gravity.data(), Ts, horizon, work.data());
+    }, nb::arg("gyr"), nb::arg("acc"), nb::arg("gravity"), nb::arg("Ts"), nb::arg("horizon"),
+          "The mean over k ≥ horizon of |acc[k] − R_kᵀ·R_(k−horizon)·gravity[k−horizon]|² (m²/s⁴), R_k the\n"
+          "sensor's orientation integrated from gyr (N×3, rad/s, over Ts s each); acc and gravity N×3, m/s²\n"
+          "(blocks/core/stages/prediction.h).");
 }

@@ -1,0 +1,111 @@
+"""Recordings made by the simulator (`attitude simulate`): a rest, then human motion
+(systems.simulation.motion.HumanMotion), measured by a sensor of a datasheet's figures at any
+rate, with the motion's exact orientation as the reference, so that `attitude evaluate` scores
+them as it scores a lab's recordings. The sensors' table loads without python-control (the command
+line's help lists it); the simulation loads it when it runs."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from attitude_fmu.systems.recordings.recording import Recording
+
+if TYPE_CHECKING:
+    from attitude_fmu.systems.simulation.sensor_model import ImuModel
+
+STANDARD_G = 9.80665  # m/s² in a g, as datasheets give accelerometer ranges
+SCALE_STREAM, OFFSET_STREAM = 2, 3  # the seed's streams of numpy's generator for the drawn errors
+MAX_SCALE_ERROR = 0.5  # rms scale and misalignment error: 50 % is no gyro's
+DEFAULT_MOTION = {"delta_v": 0.1, "grid": 0.02}  # a person moving about: 5 m/s² rms per axis at any rate
+
+
+@dataclass(frozen=True)
+class Sensor:
+    """A simulated IMU's figures, as a datasheet gives them.
+
+    gyro_noise_dps: gyro white noise, °/s/√Hz; acc_noise: accelerometer white noise,
+    m/s²/√Hz; gyro_scale_error: rms of each element of the gyro's scale-factor and
+    misalignment matrix (1 = 100 %), the matrix drawn from the seed; gyro_offset_dps: the
+    norm of the gyro's constant offset, °/s, its direction drawn from the seed; gyro_range_dps
+    (°/s) and acc_range_g (g): the full scale of each axis, beyond which a sample reads the
+    full scale (inf: none); mag_noise: magnetometer white noise, µT/√Hz.
+    """
+
+    gyro_noise_dps: float = 0.02
+    acc_noise: float = 0.002
+    gyro_scale_error: float = 0.0
+    gyro_offset_dps: float = 0.0
+    gyro_range_dps: float = math.inf
+    acc_range_g: float = math.inf
+    mag_noise: float = 0.1
+
+    def __post_init__(self):
+        for what, value, top in (("gyro noise", self.gyro_noise_dps, math.inf),
+                                 ("accelerometer noise", self.acc_noise, math.inf),
+                                 ("gyro scale error", self.gyro_scale_error, MAX_SCALE_ERROR),
+                                 ("gyro offset", self.gyro_offset_dps, math.inf),
+                                 ("magnetometer noise", self.mag_noise, math.inf)):
+            if not (math.isfinite(value) and 0.0 <= value < top):
+                raise ValueError(f"{what} must be finite, non-negative"
+                                 f"{'' if top == math.inf else f' and below {top:g}'}, got {value!r}")
+        for what, value in (("gyro range", self.gyro_range_dps), ("accelerometer range", self.acc_range_g)):
+            if not (value > 0.0):  # inf allowed: no range
+                raise ValueError(f"{what} must be a positive number (inf: none), got {value!r}")
+
+    def model(self, seed: int = 0) -> ImuModel:
+        """The sensor model with its scale-factor matrix and offset direction drawn from seed."""
+        from attitude_fmu.systems.simulation.sensor_model import ImuModel
+
+        scale = np.random.default_rng((seed, SCALE_STREAM)).normal(0.0, self.gyro_scale_error, (3, 3))
+        direction = np.random.default_rng((seed, OFFSET_STREAM)).normal(size=3)
+        offset = math.radians(self.gyro_offset_dps) * direction / np.linalg.norm(direction)
+        return ImuModel(delta_n=math.radians(self.gyro_noise_dps), acc_noise=self.acc_noise,
+                        gyr_scale=tuple(map(tuple, scale)), gyr_offset=tuple(offset), mag_noise=self.mag_noise)
+
+
+# sensors of three kinds, with figures typical of their datasheets
+SENSORS = {
+    "consumer": Sensor(gyro_noise_dps=0.007, acc_noise=180e-6 * STANDARD_G, gyro_scale_error=0.005,
+                       gyro_offset_dps=0.5, gyro_range_dps=2000.0, acc_range_g=16.0, mag_noise=0.1),
+    "low_range": Sensor(gyro_noise_dps=0.005, acc_noise=400e-6 * STANDARD_G, gyro_scale_error=0.01,
+                        gyro_offset_dps=1.0, gyro_range_dps=250.0, acc_range_g=2.0, mag_noise=0.3),
+    "calibrated": Sensor(gyro_noise_dps=0.004, acc_noise=60e-6 * STANDARD_G, gyro_scale_error=0.0005,
+                         gyro_offset_dps=0.05, gyro_range_dps=450.0, acc_range_g=8.0, mag_noise=0.05),
+}
+
+
+def simulate_recording(fs: float, duration: float, rest: float = 10.0, sensor: Sensor = SENSORS["consumer"],
+                       motion: dict | None = None, seed: int = 0, mag: bool = True,
+                       name: str = "simulated") -> Recording:
+    """A recording at fs (Hz): rest seconds still and level, then duration seconds of
+    human motion (the parameters of profile "human" updated by DEFAULT_MOTION, then by
+    motion), measured by sensor
+    (its errors drawn from seed; the motion's noise from its stream of seed, the sensor's
+    and the magnetometer's from theirs of seed + 1). The reference is the motion's orientation, the movement flag
+    0 over the rest; with mag, the magnetometer sees the simulation's earth field. Samples
+    beyond the sensor's range read its full scale; notes count them per sensor."""
+    from attitude_fmu.systems.simulation.motion import Motion, profile
+
+    human = profile("human").motion({**DEFAULT_MOTION, **(motion or {})})
+    still = round(rest * fs)
+    moving = human.generate(duration, fs, seed)
+    g = human.g
+    truth = Motion(fs, np.vstack([np.tile([1.0, 0.0, 0.0, 0.0], (still, 1)), moving.quat]),
+                   np.vstack([np.zeros((still, 3)), moving.gyr]),
+                   np.vstack([np.tile([0.0, 0.0, g], (still, 1)), moving.acc]))
+    imu = sensor.model(seed)
+    gyr, acc = imu.apply(truth, seed + 1)
+    notes = []
+    for what, values, full, unit in (("gyro", gyr, math.radians(sensor.gyro_range_dps), "°/s"),
+                                     ("accelerometer", acc, sensor.acc_range_g * STANDARD_G, "m/s²")):
+        beyond = np.abs(values) > full
+        if beyond.any():
+            np.clip(values, -full, full, out=values)
+            shown = math.degrees(full) if unit == "°/s" else full
+            notes.append(f"{name}: {np.count_nonzero(beyond.any(axis=1))} {what} samples beyond its range "
+                         f"±{shown:g} {unit} read the full scale")
+    return Recording(name, fs, gyr, acc, truth.t, mag=imu.apply_mag(truth, seed + 1) if mag else None,
+                     quat_ref=truth.quat, movement=np.arange(len(gyr)) >= still, notes=notes)
