@@ -3,7 +3,7 @@
     python docs/figures.py [--broad DIR] [--only NAME ...]
 
 runs `attitude table1 --json`, `attitude evaluate --json` (online and --offline) on the BROAD
-recordings, `attitude compare --json`, `attitude verify --json`, `attitude bench --json` (also
+recordings and on recordings `attitude simulate` makes, `attitude compare --json`, `attitude verify --json`, `attitude bench --json` (also
 `--fmu`, `--io` and `--workers 2`),
 `attitude bode` and `attitude plot`, writes what each printed to docs/generated/NAME.json, and
 from those files the Markdown tables (NAME.md, included by the pages) and the figures
@@ -163,6 +163,41 @@ def broad(refresh: bool) -> None:
     save_png(fig, "broad")
 
 
+SIMULATED_RATES = (40, 125, 1000)  # Hz: the rates of the simulated recordings
+
+
+def simulated(refresh: bool) -> None:
+    """`attitude simulate` (each sensor at each rate, 300 s of motion, seed 1) scored by `attitude evaluate`
+    online and --offline: simulated.json holds {"online": …, "offline": …} as evaluate printed them."""
+    from attitude_fmu.systems.simulation.recording import SENSORS
+
+    if refresh:
+        import tempfile
+
+        with tempfile.TemporaryDirectory() as folder:
+            files = []
+            for sensor in SENSORS:
+                for fs in SIMULATED_RATES:
+                    files.append(str(Path(folder) / f"{sensor}_{fs}Hz.csv"))
+                    attitude("simulate", "--sensor", sensor, "--fs", str(fs), "--seed", "1", "--out", files[-1])
+            data = {"online": json.loads(attitude("evaluate", "--reference-north", "magnetic", "--json", *files)),
+                    "offline": json.loads(attitude("evaluate", "--reference-north", "magnetic", "--offline", "--json",
+                                                   *files))}
+        (OUT / "simulated.json").write_text(json.dumps(data, indent=1) + "\n")
+    data = load("simulated")
+    online, offline = data["online"], data["offline"]
+    labels = [("wiener", online), ("vqf", online), ("vqf_9d", online), ("wiener_offline", offline),
+              ("vqf_offline", offline)]
+    lines = ["| recording | scale_error chosen | " + " | ".join(label for label, _ in labels) + " |",
+             "|---|---:|" + "---:|" * len(labels)]
+    for rec in online["recordings"]:
+        chosen = online.get("chosen", {}).get(rec, {}).get("scale_error")
+        cells = [f"{d['recordings'][rec][label]['inclination_rmse_deg']:.3f} / "
+                 f"{d['recordings'][rec][label]['heading_rmse_deg']:.2f}" for label, d in labels]
+        lines.append(f"| {rec} | {'' if chosen is None else format(chosen, 'g')} | " + " | ".join(cells) + " |")
+    write_md("simulated", lines)
+
+
 def compare(refresh: bool) -> None:
     data = run_json("compare", "compare") if refresh else load("compare")
     methods = list(next(iter(data["profiles"].values())))
@@ -237,7 +272,8 @@ def bode(refresh: bool) -> None:
             attitude("bode", "--method", method, "--out", str(OUT / f"bode_{method}.png"))
 
 
-FIGURES = {"table1": table1, "spectrum": spectrum, "broad": broad, "compare": compare, "verify": verify,
+FIGURES = {"table1": table1, "spectrum": spectrum, "broad": broad, "simulated": simulated, "compare": compare,
+           "verify": verify,
            "bench": bench, "bench_fmu": bench_fmu, "bench_io": bench_io,
            "bench_workers": bench_workers, "bode": bode}
 
