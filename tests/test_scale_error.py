@@ -209,3 +209,13 @@ def test_the_command_line_says_what_it_chose(tmp_path, capsys):
     assert json.loads(capsys.readouterr().out)["chosen"] == {"calibrated": {"scale_error": 0.0}}
     assert main(["evaluate", "--json", "--workers", "1", "--param", "scale_error=0.005", str(path)]) == 0
     assert "chosen" not in json.loads(capsys.readouterr().out)
+
+
+def test_the_candidates_on_threads_choose_as_one_thread_does():
+    """The candidates run at once on threads (threads=None or 2) or one after another (threads=1):
+    the same choice, the same estimate bit for bit."""
+    rec = _recording("calibrated", 1)
+    one = estimate(rec.gyr, rec.acc, rec.fs, threads=1)
+    for threads in (2, None):
+        est = estimate(rec.gyr, rec.acc, rec.fs, threads=threads)
+        assert est.chosen == one.chosen and _same(est, one)

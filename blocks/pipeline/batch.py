@@ -4,6 +4,7 @@ passes forward and backward in time, and delays measured from the whole recordin
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Mapping
 from dataclasses import dataclass
 
@@ -129,7 +130,14 @@ def estimate(
     gyro offset, or with heading up to the method, on one; the rest on the other), the
     outputs bit for bit those of one thread; None (automatic): two for 20 000 rows or more
     where the process may run on two CPUs or more and the gyro offset or the heading runs.
-    Pass 1 where processes already use every CPU (one estimate per worker).
+    The candidates of scale_error's choice (below) run on up to this many threads at once
+    (None: one per CPU the process may run on). Pass 1 where processes already use every CPU
+    (one estimate per worker).
+
+    scale_error (wiener with its local densities): unless given, chosen from the recording
+    (blocks.stages.scale_error: of its candidates, the one whose estimate predicts the
+    accelerometer best 0.5 s ahead through the gyro), online and offline alike; the value is
+    returned in `chosen`.
 
     offline: the batch-only additions (smoothed). The method's earth-frame filter runs
     forward, then backward over the forward estimate (for `wiener` the non-causal Wiener
@@ -152,7 +160,7 @@ def estimate(
         gyr, acc, mag = gyr[start:], acc[start:], None if mag is None else mag[start:]
     chosen = None
     if scale_error.applies(method, dict(pipeline.params)):
-        found = _chosen_scale_error(pipeline, step, gyr, acc, initial_gravity)
+        found = _chosen_scale_error(pipeline, step, gyr, acc, initial_gravity, threads)
         if found is not None:
             chosen = {"scale_error": found}
             pipeline = check_options(method, {**(params or {}), **chosen}, offline, gyro_offset, mag is not None,
@@ -168,10 +176,12 @@ def estimate(
     return held_before(est, start)
 
 
-def _chosen_scale_error(pipeline: Pipeline, step: Step, gyr, acc, initial_gravity) -> float | None:
+def _chosen_scale_error(pipeline: Pipeline, step: Step, gyr, acc, initial_gravity,
+                        threads: int | None) -> float | None:
     """blocks.stages.scale_error's choice for the pipeline's method over the rows (None: the
     recording is too short): the method alone, on the samples as the pipeline turns them
-    (its sample conventions, the gyro freed of its offset by the forward pass)."""
+    (its sample conventions, the gyro freed of its offset by the forward pass); candidates on
+    up to threads threads at once (None: a thread for each CPU the process may run on)."""
     fs = 1.0 / step.Ts
     gyr = interval_means(gyr) if pipeline.point_gyr else gyr
     acc = interval_ends(gyr, acc, step.Ts) if pipeline.mean_acc else acc
@@ -183,7 +193,9 @@ def _chosen_scale_error(pipeline: Pipeline, step: Step, gyr, acc, initial_gravit
         return estimate(gyr, acc, fs, pipeline.method, {**own, "scale_error": value}, initial_gravity,
                         gyro_offset=False, threads=1).gravity
 
-    found = scale_error.choose(gyr, acc, fs, gravity)
+    workers = threads if threads is not None else len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") \
+        else os.cpu_count() or 1
+    found = scale_error.choose(gyr, acc, fs, gravity, workers)
     return None if found is None else found[0]
 
 

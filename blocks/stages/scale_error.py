@@ -21,6 +21,7 @@ to 8 % above 0.005's error), and a start-up within the first seconds weighs on i
 from __future__ import annotations
 
 import math
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
@@ -44,13 +45,23 @@ def prediction_error(gyr, acc, gravity, fs: float, horizon: float = PREDICTION_H
                                   np.ascontiguousarray(gravity, dtype=float), 1.0 / fs, m)
 
 
-def choose(gyr, acc, fs: float, run) -> tuple[float, dict[float, float]] | None:
+def choose(gyr, acc, fs: float, run, workers: int = 1) -> tuple[float, dict[float, float]] | None:
     """(the chosen scale error, {candidate: prediction error}) for gyr (N×3 rad/s, freed of its
     offset) and acc (N×3 m/s²) at fs Hz; run(scale_error) gives the method's gravity (N×3,
-    m/s²) with that value. None where the recording is no longer than the horizon."""
+    m/s²) with that value. None where the recording is no longer than the horizon. workers:
+    candidates run at once on threads (the C core runs without Python's lock), the result the
+    same."""
     if len(gyr) <= max(1, round(PREDICTION_HORIZON_S * fs)):
         return None
-    errors = {c: prediction_error(gyr, acc, run(c), fs) for c in SCALE_ERRORS}
+
+    def error(candidate: float) -> float:
+        return prediction_error(gyr, acc, run(candidate), fs)
+
+    if workers > 1:
+        with ThreadPoolExecutor(max_workers=min(workers, len(SCALE_ERRORS))) as pool:
+            errors = dict(zip(SCALE_ERRORS, pool.map(error, SCALE_ERRORS)))
+    else:
+        errors = {c: error(c) for c in SCALE_ERRORS}
     best = min(errors, key=lambda c: (errors[c], -c))  # a tie keeps the larger, the nearer the default
     return (best, errors) if math.isfinite(errors[best]) else None
 
