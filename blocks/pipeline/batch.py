@@ -4,7 +4,6 @@ passes forward and backward in time, and delays measured from the whole recordin
 from __future__ import annotations
 
 import math
-import os
 from collections.abc import Mapping
 from dataclasses import dataclass
 
@@ -193,9 +192,7 @@ def _chosen_scale_error(pipeline: Pipeline, step: Step, gyr, acc, initial_gravit
         return estimate(gyr, acc, fs, pipeline.method, {**own, "scale_error": value}, initial_gravity,
                         gyro_offset=False, threads=1).gravity
 
-    workers = threads if threads is not None else len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") \
-        else os.cpu_count() or 1
-    found = scale_error.choose(gyr, acc, fs, gravity, workers)
+    found = scale_error.choose(gyr, acc, fs, gravity, _core.cpus() if threads is None else threads)
     return None if found is None else found[0]
 
 

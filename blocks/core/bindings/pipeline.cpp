@@ -221,6 +221,8 @@ void bind_pipeline(nb::module_ &m)
     m.attr("MAX_GYR_RAD_S") = MAX_GYR_RAD_S;
     m.attr("MAX_ACC_M_S2") = MAX_ACC_M_S2;
 
+    m.def("cpus", &cpus, "The CPUs this process may run on (its affinity on Linux), as the batch path counts them.");
+
     // ---- parameters
     m.def(
         "method_index", [](std::optional<std::string> name) { return method_of(name); }, "name"_a.none(),

@@ -26,15 +26,6 @@ int split_stage(const AfPipeline &pipeline)
     return 0;
 }
 
-// the CPUs this process may run on
-unsigned cpus()
-{
-#ifdef __linux__
-    cpu_set_t set;
-    if (sched_getaffinity(0, sizeof set, &set) == 0) return static_cast<unsigned>(CPU_COUNT(&set));
-#endif
-    return std::thread::hardware_concurrency();
-}
 
 // the rows a thread has done, on a cache line of its own
 struct alignas(64) Progress {
@@ -100,6 +91,15 @@ struct Pipelined {
 };
 
 } // namespace
+
+unsigned cpus()
+{
+#ifdef __linux__
+    cpu_set_t set;
+    if (sched_getaffinity(0, sizeof set, &set) == 0) return static_cast<unsigned>(CPU_COUNT(&set));
+#endif
+    return std::thread::hardware_concurrency();
+}
 
 void pipelined_run(const AfPipeline &pipeline, const AfStep &step, AfState &state, size_t n, const AfInputs &in,
                    const AfRows &out, int threads)

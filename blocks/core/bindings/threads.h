@@ -19,6 +19,9 @@ constexpr size_t THREADED_ROWS = 20000;
 // the stages' cost balanced between them (without heading: timing and gyro offset | method and
 // latency; with heading: up to the method | heading and latency); the outputs are bit for bit
 // those of one thread. No Python object is touched: run it without the GIL.
+// the CPUs this process may run on (its affinity on Linux, else the hardware's threads)
+unsigned cpus();
+
 void pipelined_run(const AfPipeline &pipeline, const AfStep &step, AfState &state, size_t n, const AfInputs &in,
                    const AfRows &out, int threads);
 
