@@ -22,6 +22,8 @@ from scipy.spatial.transform import Rotation
 
 GOLDEN = Path(__file__).with_name("golden.npz")
 FROZEN_SCALE_ERROR = {"scale_error": 0.005}  # the estimate cases' value (frozen before the batch path chose it)
+# the heading's low-pass off (1 - exp(-Ts/1 ns) is 1): each field sample judged alone, as when the cases were frozen
+FROZEN_MAG_GUARD = {"tau_mag_guard": 1e-9}
 
 
 def as_online(method: str = "wiener", params=None) -> dict:
@@ -131,7 +133,8 @@ ONLINE_OUTPUTS = ("quat", "up", "euler", "offset", "mag_offset", "mag_delay")
 
 def _stage_params(heading, gyro_offset):
     params = {"delta_n": math.radians(0.05), "rest_time": 1.0, "tau_acc": 1.0} if gyro_offset else {}
-    return {**params, "tau_heading": 2.0, "mag_new_time": 4.0, "mag_cal_time": 8.0} if heading else params
+    heading_params = {"tau_heading": 2.0, "mag_new_time": 4.0, "mag_cal_time": 8.0, **FROZEN_MAG_GUARD}
+    return {**params, **heading_params} if heading else params
 
 
 def online_configs():
@@ -171,13 +174,15 @@ def run_methods(name, given):
 
 def estimate_case(**options):
     """estimate() over recording_9d: quat, gravity and, where made, offset, mag_accepted, mag_offset, mag_delay;
-    scale_error held at FROZEN_SCALE_ERROR (tests/test_scale_error.py holds the choice of it)."""
+    scale_error held at FROZEN_SCALE_ERROR (tests/test_scale_error.py holds the choice of it), the
+    heading's low-pass off (FROZEN_MAG_GUARD)."""
     from attitude_fmu import estimate
 
     gyr, acc, mag, fs = recording_9d()
-    if not options.pop("with_mag", True):
-        mag = None
-    options["params"] = as_online(options.get("method", "wiener"), options.get("params"))
+    with_mag = options.pop("with_mag", True)
+    mag = mag if with_mag else None
+    options["params"] = as_online(options.get("method", "wiener"), {**(FROZEN_MAG_GUARD if with_mag else {}),
+                                                                    **options.get("params", {})})
     est = estimate(gyr, acc, fs, mag=mag, **options)
     out = {"quat": rows(est.quat, 2 * DECIMATE), "gravity": rows(est.gravity, 2 * DECIMATE)}
     for name in ("offset", "mag_accepted", "mag_offset", "mag_delay"):
@@ -200,13 +205,14 @@ ESTIMATE_CASES = {
 
 
 def broad_case(offline):
-    """estimate() with the defaults (scale_error held at FROZEN_SCALE_ERROR) over the first 30 s of a
-    BROAD recording (9D)."""
+    """estimate() with the defaults (scale_error held at FROZEN_SCALE_ERROR, the heading's low-pass off)
+    over the first 30 s of a BROAD recording (9D)."""
     from attitude_fmu import estimate, read_recording
 
     rec = read_recording(BROAD_RECORDING)
     n = int(30.0 * rec.fs)
-    est = estimate(rec.gyr[:n], rec.acc[:n], rec.fs, mag=rec.mag[:n], offline=offline, params=FROZEN_SCALE_ERROR)
+    est = estimate(rec.gyr[:n], rec.acc[:n], rec.fs, mag=rec.mag[:n], offline=offline,
+                   params={**FROZEN_SCALE_ERROR, **FROZEN_MAG_GUARD})
     return {"quat": rows(est.quat, 2 * DECIMATE), "gravity": rows(est.gravity, 2 * DECIMATE), "offset": rows(est.offset, 2 * DECIMATE)}
 
 
@@ -245,7 +251,7 @@ def stages_case():
         out[f"offset offline={offline}"] = rows(offset, 2 * DECIMATE)
     quat = Rotation.from_rotvec(np.cumsum(gyr, axis=0) / fs).as_quat(scalar_first=True)  # any orientation stream
     for params in ({}, {"mag_delay": 0.03, "mag_cal_time": 20.0}, {"mag_new_time": 5.0}):
-        q, accepted, offset, delay = heading.with_magnetometer(quat, mag, fs, params)
+        q, accepted, offset, delay = heading.with_magnetometer(quat, mag, fs, {**params, **FROZEN_MAG_GUARD})
         key = " ".join(f"{k}={v}" for k, v in params.items())
         out.update({f"heading quat {key}": rows(q, 2 * DECIMATE), f"heading accepted {key}": accepted,
                     f"heading offset {key}": rows(offset, 2 * DECIMATE), f"heading delay {key}": rows(delay, 2 * DECIMATE)})
@@ -319,8 +325,8 @@ def fmu_cases(folder) -> dict[str, dict[str, np.ndarray]]:
     for method in ("wiener", "luinge", "tseng_adaptive"):
         for version, path in (("2.0", folder / "native" / "AttitudeEstimator.fmu"),
                               ("3.0", folder / "native" / "fmi3" / "AttitudeEstimator.fmu")):
-            out[f"AttitudeEstimator {version} {method}"] = {"out": _simulate(
-                path, {"method": method, "Ts": FMU_STEP, "tau_heading": 2.0}, inputs, outputs=estimated)}
+            start = {"method": method, "Ts": FMU_STEP, "tau_heading": 2.0, **FROZEN_MAG_GUARD}
+            out[f"AttitudeEstimator {version} {method}"] = {"out": _simulate(path, start, inputs, outputs=estimated)}
     truth = ["omega_x", "omega_y", "omega_z", "f_x", "f_y", "f_z", "m_x", "m_y", "m_z", "qt_w", "qt_x", "qt_y",
              "qt_z"]
     motion = folder / "native" / "MotionProfile.fmu"

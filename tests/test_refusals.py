@@ -96,8 +96,8 @@ def test_every_parameter_outside_its_range_is_refused_with_the_message_its_table
     (dict(method="tseng", params={"k_P": 1.0}, heading=True),
      "unknown parameter 'k_P' (the method tseng: none; the gyro-offset estimator: rest_gyr, rest_gyr_abs, rest_acc, "
      "rest_time, tau_lp, tau_short, delta_n, tau_acc, sigma_init, sigma_motion, tau_motion; the heading estimator: "
-     "tau_heading, mag_norm_tol, mag_dip_tol, tau_reference, heading_clip, mag_new_time, mag_new_angle, mag_delay, "
-     "mag_cal_time, mag_cal_spread, mag_cal_tol, mag_cal_recent, tau_mag_delay)"),
+     "tau_heading, mag_norm_tol, mag_dip_tol, tau_mag_guard, tau_reference, heading_clip, mag_new_time, "
+     "mag_new_angle, mag_delay, mag_cal_time, mag_cal_spread, mag_cal_tol, mag_cal_recent, tau_mag_delay)"),
     (dict(method="mahony", params={"scale_error": 0.0}),
      "unknown parameter 'scale_error' (the method mahony: k_P, k_I, g; the gyro-offset estimator: rest_gyr, "
      "rest_gyr_abs, rest_acc, rest_time, tau_lp, tau_short, delta_n, tau_acc, sigma_init, sigma_motion, tau_motion)"),

@@ -8,7 +8,12 @@ a = 1 − exp(−Ts/tau) and the innovation clipped to ±heading_clip (a robust 
 disturbance that slips through the guard pulls by at most heading_clip/tau_heading per
 second). Start-up: over the first tau_heading seconds every sample is used, unclipped,
 with the weight 1/n of a running mean, and the reference norm and dip are their running
-means (the first samples may come in motion, while the tilt is still settling). Then
+means (the first samples may come in motion, while the tilt is still settling). The field
+the heading follows and the guard judges is the tilt-compensated one (earth frame) through a
+first-order low-pass of tau_mag_guard (0.05 s): a field fixed in the earth frame passes
+unchanged, the sensor's noise is averaged (a fast, noisy magnetometer's samples would
+otherwise leave the tolerances by noise alone, and the clipped innovations would pull less
+than the error), and a disturbance is seen within tau_mag_guard. Then
 the guard against magnetic disturbances: a sample is used only while the field's norm
 and dip stay within tolerance of the reference, which is tracked slowly (tau_reference)
 over accepted samples; otherwise the heading is the gyro's. A new reference: a field

@@ -16,6 +16,8 @@ int heading_coefficients(const double params[AF_N_PARAMS], double Ts, AfHeadingC
     coef->rate_reference = Ts / params[AF_P_tau_reference];
     coef->a_heading = 1.0 - exp(-Ts / params[AF_P_tau_heading]);
     coef->a_reference = 1.0 - exp(-Ts / params[AF_P_tau_reference]);
+    coef->rate_guard = Ts / params[AF_P_tau_mag_guard];
+    coef->a_guard = 1.0 - exp(-Ts / params[AF_P_tau_mag_guard]);
     coef->norm_tol = params[AF_P_mag_norm_tol];
     coef->dip_tol = params[AF_P_mag_dip_tol];
     coef->clip = params[AF_P_heading_clip];
@@ -74,16 +76,26 @@ static double heading_error(Vec3 m, double psi)
 }
 
 /* field_sample: the field m (earth frame before the turn by psi_c about up, which leaves its norm,
- * horizontal norm (> 0) and dip alone) taken into psi_c and the reference; whether it was used */
-static int field_sample(AfHeading *state, const AfHeadingCoef *coef, Quat q, Vec3 m, double horizontal)
+ * horizontal norm and dip alone) taken into psi_c and the reference; whether it was used. What the
+ * guard judges and the heading follows is m through a low-pass of tau_mag_guard, which averages a
+ * fast magnetometer's noise (a field fixed in the earth frame passes it unchanged); the start-up
+ * begins it at the sample. */
+static int field_sample(AfHeading *state, const AfHeadingCoef *coef, Quat q, Vec3 m)
 {
     double clip = coef->clip;
-    double norm = sqrt(horizontal * horizontal + m.z * m.z);
-    double dip = atan2(-m.z, horizontal);
     double gap = state->gap;
     state->gap = 0.0;
+    double a_low = state->seen == 0.0 ? 1.0 : pull(gap, coef->rate_guard, coef->a_guard);
     if (state->seen == 0.0)
         state->steps = 1.0;
+    double *f = state->m_low;
+    f[0] += a_low * (m.x - f[0]), f[1] += a_low * (m.y - f[1]), f[2] += a_low * (m.z - f[2]);
+    m = (Vec3){f[0], f[1], f[2]};
+    double horizontal = sqrt(m.x * m.x + m.y * m.y);
+    if (horizontal == 0.0) /* a field with no heading */
+        return 0;
+    double norm = sqrt(horizontal * horizontal + m.z * m.z);
+    double dip = atan2(-m.z, horizontal);
     state->seen += 1.0;
     int start = 1.0 / state->steps > coef->a_heading; /* within tau_heading of the start */
     int ok = 0;
@@ -173,10 +185,7 @@ Quat heading_step(AfHeading *state, const AfHeadingCoef *coef, Quat q, Vec3 m_se
         }
         double steps = state->mag_delay.delay / Ts;
         Quat q_field = steps != 0.0 ? turned_back(q, turn, steps) : q;
-        Vec3 m = quat_rotate(q_field, m_sensor); /* turned by psi_c in field_sample */
-        double horizontal = sqrt(m.x * m.x + m.y * m.y);
-        if (horizontal > 0.0) /* a field with a heading */
-            *ok = field_sample(state, coef, q, m, horizontal);
+        *ok = field_sample(state, coef, q, quat_rotate(q_field, m_sensor)); /* turned by psi_c there */
         if (online) {
             Vec3 rate = {turn.x / Ts, turn.y / Ts, turn.z / Ts};
             mag_delay_field_sample(&state->mag_delay, &coef->mag_delay, m_sensor, rate, *ok);
