@@ -252,7 +252,8 @@ def test_evaluate_json_contract_on_synthetic_recordings(tmp_path, capsys):
         _broad_like(tmp_path / f"{name}.mat", motion)
     assert main(["evaluate", "--json", "--workers", "1", str(tmp_path / "a.mat"), str(tmp_path / "b.mat")]) == 0
     result = json.loads(capsys.readouterr().out)
-    assert set(result) == {"recordings", "mean", "imu_latency_s", "chosen"} and set(result["recordings"]) == {"a", "b"}
+    assert set(result) == {"recordings", "mean", "imu_latency_s", "chosen", "mag_used"}
+    assert set(result["recordings"]) == {"a", "b"} and set(result["mag_used"]) == {"a", "b"}
     assert set(result["chosen"]) == {"a", "b"}  # each recording's scale_error (blocks.stages.scale_error)
     assert all(found["scale_error"] in SCALE_ERRORS for found in result["chosen"].values())
     assert all(abs(lag) < 1e-3 for lag in result["imu_latency_s"].values())  # written without a delay (slow turns)

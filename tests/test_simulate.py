@@ -201,3 +201,25 @@ def test_evaluate_scores_a_simulated_recording(tmp_path, capsys):
         assert 0.0 < scores[method]["inclination_rmse_deg"] < 3.0, scores
     for method in ("wiener", "vqf_9d"):
         assert 0.0 < scores[method]["heading_rmse_deg"] < 3.0, scores
+
+
+def test_evaluate_reports_the_share_of_field_samples_the_heading_used(tmp_path, capsys):
+    """A magnet beside the sensor in spells (the field 60 % stronger for 10 s of every 12.5 s of
+    the movement, shorter than mag_new_time, so never taken as a new field): the guard refuses
+    those samples, and evaluate reports the share it used as the spells leave it (within the
+    low-pass's edges, 0.02) and notes it, being below half; the clean copy uses every sample, unnoted."""
+    rec = simulate_recording(100.0, 60.0, rest=10.0, seed=3)
+    moving = rec.movement.astype(bool)
+    spell = moving & (np.mod(rec.t - rec.t[moving][0], 12.5) < 10.0)
+    write_recording(tmp_path / "clean.csv", rec)
+    write_recording(tmp_path / "magnet.csv", replace(rec, mag=np.where(spell[:, None], 1.6 * rec.mag, rec.mag)))
+    capsys.readouterr()
+    assert main(["evaluate", "--json", str(tmp_path / "clean.csv"), str(tmp_path / "magnet.csv")]) == 0
+    captured = capsys.readouterr()
+    used = json.loads(captured.out)["mag_used"]
+    expected = 1.0 - spell[moving].mean()
+    print(f"used {used}, clean share of the magnet's movement {expected:.3f}")
+    assert used["clean"] > 0.999 and abs(used["magnet"] - expected) < 0.02
+    assert (f"magnet: the heading used the magnetometer for {100 * used['magnet']:.0f} % of the movement's field "
+            "samples; the disturbance guard refused the rest") in captured.err
+    assert "clean: the heading used" not in captured.err

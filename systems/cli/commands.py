@@ -607,6 +607,9 @@ def cmd_evaluate(args) -> int:
         print(f"scale_error chosen from each recording (the best prediction of the accelerometer "
               f"{PREDICTION_HORIZON_S:g} s ahead; --param scale_error=V holds one): "
               + ", ".join(f"{name} {found['scale_error']:g}" for name, found in result["chosen"].items()))
+    if "mag_used" in result:
+        print("magnetometer samples the heading used over the movement (the guard refused the rest): "
+              + ", ".join(f"{name} {100 * used:.0f} %" for name, used in result["mag_used"].items()))
     return status
 
 

@@ -32,6 +32,7 @@ REFERENCE_ORDERS = {  # a reference stored otherwise, as its columns w,x,y,z rea
 }
 REFERENCE_RATIO = 4.0  # how much better another order must fit the estimate to be noted
 REFERENCE_NOTE_DEG = 5.0  # nor is anything said below this inclination RMSE (deg) as the reference is read
+MAG_USED_NOTE = 0.5  # a recording whose heading used fewer of the movement's field samples than this is noted
 REFERENCE_NORTH = ("other", "magnetic")  # the reference's north: another (its offset removed), or magnetic
 
 
@@ -104,7 +105,8 @@ def method_label(method: str, offline: bool) -> str:
 def evaluate_recording(rec: Recording, method: str = "wiener", params=None, offline: bool = False,
                        gyro_offset: bool = True, use_mag: bool = True, latency: float = 0.0,
                        peers: bool = True, threads: int | None = None, align: bool = False,
-                       magnetic: bool = False, alignment: dict | None = None, chosen: dict | None = None) -> dict:
+                       magnetic: bool = False, alignment: dict | None = None, chosen: dict | None = None,
+                       mag_used: dict | None = None) -> dict:
     """{method label: {metric: value}} for one recording; with a magnetometer (and use_mag)
     the method's heading comes from it, and vqf's 9D estimate is added as "vqf_9d". A
     reference that fits far better in another order is noted in rec.notes
@@ -117,7 +119,10 @@ def evaluate_recording(rec: Recording, method: str = "wiener", params=None, offl
     given (Alignment.to_json). magnetic: the reference's north is magnetic north, the
     estimate's; else (the default) each estimate's constant heading offset from the reference is
     removed before its heading error (errors_on_movement). chosen: a dict that receives the
-    parameters the estimate chose from the recording (AttitudeEstimate.chosen), when given."""
+    parameters the estimate chose from the recording (AttitudeEstimate.chosen), when given;
+    mag_used: a dict that receives {"fraction": the share of the movement's field samples the
+    heading used (the rest the disturbance guard refused)}, when given and heading came from the
+    magnetometer; below MAG_USED_NOTE a note in rec.notes says so (mag_used_note)."""
     rec.evaluated()  # refuses a recording without a usable reference before any work
     label = method_label(method, offline)
     mag = rec.mag if use_mag else None
@@ -141,6 +146,14 @@ def evaluate_recording(rec: Recording, method: str = "wiener", params=None, offl
         rec.notes.append(note)
     if est.chosen is not None and chosen is not None:
         chosen.update(est.chosen)
+    if est.mag_accepted is not None:
+        sampled = rec.evaluated() & np.isfinite(mag).all(axis=1)
+        fraction = float(est.mag_accepted[sampled].mean()) if sampled.any() else math.nan
+        if mag_used is not None:
+            mag_used["fraction"] = fraction
+        note = mag_used_note(rec.name, fraction, params)
+        if note:
+            rec.notes.append(note)
     if not peers:
         return {label: errors_on_movement(est.quat, rec, magnetic)}
     import vqf as vqf_module  # peers: the test extra (or [peers])
@@ -155,6 +168,20 @@ def evaluate_recording(rec: Recording, method: str = "wiener", params=None, offl
         mag = np.ascontiguousarray(np.where(np.isnan(mag).any(axis=1, keepdims=True), 0.0, mag))
         table["vqf_9d"] = peer(vqf_module.VQF(1.0 / rec.fs).updateBatch(gyr, acc, mag)["quat9D"])
     return table
+
+
+def mag_used_note(name: str, fraction: float, params=None) -> str | None:
+    """A note where the heading used fewer than MAG_USED_NOTE of the movement's field samples
+    (fraction; params: the evaluation's, whose mag_norm_tol and mag_dip_tol it names)."""
+    if not fraction < MAG_USED_NOTE:
+        return None
+    from attitude_fmu.blocks.stages import heading
+
+    given = heading.resolve({k: v for k, v in (params or {}).items() if k in ("mag_norm_tol", "mag_dip_tol")})
+    return (f"{name}: the heading used the magnetometer for {100 * fraction:.0f} % of the movement's field samples; "
+            f"the disturbance guard refused the rest (norm more than {100 * given['mag_norm_tol']:g} % or dip more "
+            f"than {math.degrees(given['mag_dip_tol']):g}° off the reference): a disturbed place, or a field the "
+            "magnetometer's calibration leaves off? --param mag_norm_tol=F --param mag_dip_tol=RAD widen the guard")
 
 
 @dataclass(frozen=True)
@@ -203,14 +230,14 @@ def evaluate_file(path, setup: Setup, peers: bool = True) -> dict:
     alone ("table" holds the method's label only, imu_latency_s None), as a sweep needs them."""
     rec = read_prepared(path, setup)
     alignment = {} if setup.align else None
-    chosen = {}
+    chosen, mag_used = {}, {}
     table = evaluate_recording(rec, setup.method, setup.params, setup.offline, setup.gyro_offset, setup.use_mag,
                                setup.latency, peers, setup.threads, setup.align,
-                               magnetic_north(setup.reference_north), alignment, chosen)
+                               magnetic_north(setup.reference_north), alignment, chosen, mag_used)
     notes = rec.notes + ([f"{rec.name}: no movement flag; errors over every sample with a reference"]
                          if rec.movement is None else [])
     result = {"table": table, "imu_latency_s": imu_latency(rec) if peers and not setup.align else None,
-              "notes": notes, "chosen": chosen}
+              "notes": notes, "chosen": chosen, "mag_used": mag_used.get("fraction")}
     return result if alignment is None else {**result, "alignment": alignment}
 
 
@@ -273,7 +300,10 @@ def evaluate(paths, method: str = "wiener", params=None, offline: bool = False, 
     estimate's constant heading offset from the reference is removed before its heading error)
     or "magnetic" (the reference's north is magnetic north, as BROAD's: kept). by: the means over each group of recordings too, under "by_group"
     (by_group). "chosen": {name: {parameter: value}} holds what each estimate chose from its
-    recording (blocks.stages.scale_error), where it chose."""
+    recording (blocks.stages.scale_error), where it chose. "mag_used": {name: fraction} holds the
+    share of each recording's field samples over the movement that its heading used (the
+    disturbance guard refused the rest), where the heading came from the magnetometer; a
+    recording under MAG_USED_NOTE is noted."""
     jobs = jobs or Jobs(bar=progress)
     setup = Setup(method, params, offline, gyro_offset, use_mag, start_in_movement, read_options, latency,
                   gyr_samples, acc_samples, job_threads(jobs), align, reference_north)
@@ -299,6 +329,9 @@ def evaluate(paths, method: str = "wiener", params=None, offline: bool = False, 
     chosen = {name: result["chosen"] for name, result in done.items() if result.get("chosen")}
     if chosen:
         out["chosen"] = chosen
+    mag_used = {name: result["mag_used"] for name, result in done.items() if result.get("mag_used") is not None}
+    if mag_used:
+        out["mag_used"] = mag_used
     if by:
         out["by_group"] = by_group(recordings, by)
     failed = {name: result.message for name, result in zip(names, results) if isinstance(result, Failure)}
