@@ -164,27 +164,25 @@ def broad(refresh: bool) -> None:
 
 
 SIMULATED_RATES = (40, 125, 1000)  # Hz: the rates of the simulated recordings
+SIMULATED_VIGOUR = (0.02, 0.3)  # m/s/√Hz: the human motion's slosh (delta_v) at 125 Hz; the default is 0.1
 
 
-def simulated(refresh: bool) -> None:
-    """`attitude simulate` (each sensor at each rate, 300 s of motion, seed 1) scored by `attitude evaluate`
-    online and --offline: simulated.json holds {"online": …, "offline": …} as evaluate printed them."""
-    from attitude_fmu.systems.simulation.recording import SENSORS
+def _simulated_runs(specs) -> dict:
+    """`attitude simulate` for each (name, its flags), scored by `attitude evaluate` online and
+    --offline: {"online": …, "offline": …} as evaluate printed them."""
+    import tempfile
 
-    if refresh:
-        import tempfile
+    with tempfile.TemporaryDirectory() as folder:
+        files = []
+        for name, flags in specs:
+            files.append(str(Path(folder) / f"{name}.csv"))
+            attitude("simulate", *flags, "--seed", "1", "--out", files[-1])
+        return {"online": json.loads(attitude("evaluate", "--reference-north", "magnetic", "--json", *files)),
+                "offline": json.loads(attitude("evaluate", "--reference-north", "magnetic", "--offline", "--json",
+                                               *files))}
 
-        with tempfile.TemporaryDirectory() as folder:
-            files = []
-            for sensor in SENSORS:
-                for fs in SIMULATED_RATES:
-                    files.append(str(Path(folder) / f"{sensor}_{fs}Hz.csv"))
-                    attitude("simulate", "--sensor", sensor, "--fs", str(fs), "--seed", "1", "--out", files[-1])
-            data = {"online": json.loads(attitude("evaluate", "--reference-north", "magnetic", "--json", *files)),
-                    "offline": json.loads(attitude("evaluate", "--reference-north", "magnetic", "--offline", "--json",
-                                                   *files))}
-        (OUT / "simulated.json").write_text(json.dumps(data, indent=1) + "\n")
-    data = load("simulated")
+
+def _simulated_table(data) -> list[str]:
     online, offline = data["online"], data["offline"]
     labels = [("wiener", online), ("vqf", online), ("vqf_9d", online), ("wiener_offline", offline),
               ("vqf_offline", offline)]
@@ -195,7 +193,25 @@ def simulated(refresh: bool) -> None:
         cells = [f"{d['recordings'][rec][label]['inclination_rmse_deg']:.3f} / "
                  f"{d['recordings'][rec][label]['heading_rmse_deg']:.2f}" for label, d in labels]
         lines.append(f"| {rec} | {'' if chosen is None else format(chosen, 'g')} | " + " | ".join(cells) + " |")
-    write_md("simulated", lines)
+    return lines
+
+
+def simulated(refresh: bool) -> None:
+    """`attitude simulate` (300 s of motion, seed 1) scored by `attitude evaluate` online and --offline:
+    each sensor at each rate (simulated.json, {"online": …, "offline": …} as evaluate printed them), and
+    each sensor at 125 Hz in gentler and more vigorous motion (simulated_motion.json, the same)."""
+    from attitude_fmu.systems.simulation.recording import SENSORS
+
+    if refresh:
+        rates = _simulated_runs((f"{sensor}_{fs}Hz", ("--sensor", sensor, "--fs", str(fs)))
+                                for sensor in SENSORS for fs in SIMULATED_RATES)
+        (OUT / "simulated.json").write_text(json.dumps(rates, indent=1) + "\n")
+        motion = _simulated_runs((f"{sensor}_delta_v_{dv:g}", ("--sensor", sensor, "--fs", "125", "--motion",
+                                                                f"delta_v={dv:g}"))
+                                 for sensor in SENSORS for dv in SIMULATED_VIGOUR)
+        (OUT / "simulated_motion.json").write_text(json.dumps(motion, indent=1) + "\n")
+    write_md("simulated", _simulated_table(load("simulated")))
+    write_md("simulated_motion", _simulated_table(load("simulated_motion")))
 
 
 def compare(refresh: bool) -> None:
