@@ -147,8 +147,9 @@ HEADING = (
           low=1e-6, high=10.0),
     Param("mag_dip_tol", math.radians(5.0), "rad", "largest deviation of the dip angle from its reference",
           **ANGLE_RAD),
-    Param("tau_mag_guard", 0.05, "s", "time constant of the low-pass through which the guard sees the field's norm "
-          "and dip: the magnetometer's noise averaged over it, not judged sample by sample", **TIME_S),
+    Param("tau_mag_guard", 0.05, "s", "time constant of the low-pass of the tilt-compensated field that the guard "
+          "judges and the heading follows: the magnetometer's noise averaged over it, not judged sample by sample",
+          **TIME_S),
     Param("tau_reference", 60.0, "s", "time constant of the reference norm and dip", **TIME_S),
     Param("heading_clip", math.radians(10.0), "rad", "largest heading innovation one sample may use", **ANGLE_RAD),
     Param("mag_new_time", 20.0, "s", "how long a field outside the reference's tolerance must stay steady to replace it",

@@ -18,8 +18,8 @@
  * the start-up began; the step the candidate began at; the steps since the last field sample; the
  * last step's orientation (0: none yet). The hard-iron fit's and the delay's states follow. */
 #define HEADING_FIELDS(X)                                                                                          \
-    X(psi_c, ) X(m_low, [3]) X(ref_norm, ) X(ref_dip, ) X(seen, ) X(cand_norm, ) X(cand_dip, ) X(cand_n, ) X(cand_dot, )          \
-    X(cand_q0, [4]) X(steps, ) X(cand_start, ) X(gap, ) X(q_prev, [4])
+    X(psi_c, ) X(m_low, [3]) X(ref_norm, ) X(ref_dip, ) X(seen, ) X(cand_norm, ) X(cand_dip, ) X(cand_n, )         \
+    X(cand_dot, ) X(cand_q0, [4]) X(steps, ) X(cand_start, ) X(gap, ) X(q_prev, [4])
 typedef struct {
     HEADING_FIELDS(AF_DOUBLES)
     AfHardIron hard_iron;
@@ -32,10 +32,10 @@ extern const size_t HEADING_N_FIELDS;
 typedef struct {
     double rate_heading, rate_reference, rate_guard; /* Ts/tau_heading, Ts/tau_reference, Ts/tau_mag_guard */
     double a_heading, a_reference, a_guard;          /* 1 - exp(-Ts/tau) of each */
-    double norm_tol, dip_tol, clip;      /* mag_norm_tol, mag_dip_tol (rad), heading_clip (rad) */
-    double new_steps;                    /* mag_new_time/Ts */
-    double cos_half_turn;                /* cos(mag_new_angle/2) */
-    double delay;                        /* mag_delay (s); NaN: estimated online */
+    double norm_tol, dip_tol, clip;                  /* mag_norm_tol, mag_dip_tol (rad), heading_clip (rad) */
+    double new_steps;                                /* mag_new_time/Ts */
+    double cos_half_turn;                            /* cos(mag_new_angle/2) */
+    double delay;                                    /* mag_delay (s); NaN: estimated online */
     AfHardIronCoef hard_iron;
     AfMagDelayCoef mag_delay;
 } AfHeadingCoef;
