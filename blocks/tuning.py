@@ -25,6 +25,7 @@ from attitude_fmu.blocks.params import (
 
 STANDARD_GRAVITY = 9.81  # m/s², the value the project uses for |g|
 NOMINAL_DELTA_V = 1.0  # m/s/√Hz: vigorous human motion (Rizun's Table 1), when delta_v is unset
+GUARD_NOISE_MARGIN = 5.0  # tau_mag_guard unset: the guard's tightest tolerance in s.d. of the noise left
 REST_NOISE_SIGMAS = 4.5  # the least rest_gyr in units of the gyro noise's per-axis s.d. through tau_short
 
 NOISE_PARAMS = (
@@ -147,9 +148,10 @@ HEADING = (
           low=1e-6, high=10.0),
     Param("mag_dip_tol", math.radians(5.0), "rad", "largest deviation of the dip angle from its reference",
           **ANGLE_RAD),
-    Param("tau_mag_guard", 0.05, "s", "time constant of the low-pass of the tilt-compensated field that the guard "
-          "judges and the heading follows: the magnetometer's noise averaged over it, not judged sample by sample",
-          **TIME_S),
+    Param("tau_mag_guard", None, "s", "time constant of the low-pass of the tilt-compensated field that the guard "
+          "judges and the heading follows: the magnetometer's noise averaged over it, not judged sample by sample; "
+          "unset: from the noise the magnetometer shows, measured online (the guard's tightest tolerance "
+          f"{GUARD_NOISE_MARGIN:g} s.d. of the noise left, blocks.stages.heading)", **TIME_S),
     Param("tau_reference", 60.0, "s", "time constant of the reference norm and dip", **TIME_S),
     Param("heading_clip", math.radians(10.0), "rad", "largest heading innovation one sample may use", **ANGLE_RAD),
     Param("mag_new_time", 20.0, "s", "how long a field outside the reference's tolerance must stay steady to replace it",

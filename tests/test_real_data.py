@@ -17,7 +17,7 @@ from attitude_fmu.blocks.filters import accuracy as ac
 from attitude_fmu.blocks.filters import earth_filters as ef
 from attitude_fmu.blocks.pipeline.batch import estimate
 from attitude_fmu.blocks.stages.gyro_offset import correct as correct_gyro
-from attitude_fmu.blocks.stages.heading import resolve as heading_params, with_magnetometer
+from attitude_fmu.blocks.stages.heading import with_magnetometer
 from attitude_fmu.blocks.stages.scale_error import SCALE_ERRORS
 from attitude_fmu.blocks.stages.timing import interval_means
 from attitude_fmu.systems.cli.commands import main
@@ -554,8 +554,8 @@ def test_a_new_field_needs_the_sensor_to_turn():
     turning) changes its norm and dip as the sensor turns: never taken as the reference
     (the hard-iron fit, which would remove it, off), the output equals that of an
     estimator that never takes one. A steady new field at a sensor that does not turn is
-    refused as well, until mag_new_angle asks for no turn; its step is seen within the guard's
-    low-pass, tau_mag_guard."""
+    refused as well, until mag_new_angle asks for no turn; its step is seen at once (a field
+    without noise needs no low-pass before the guard, blocks.stages.heading)."""
     motion, gyr, acc, mag = _turns_with_field()
     mag[20000:] += [30.0, 0.0, 0.0]
     quat = estimate(gyr, acc, FS, gyro_offset=False).quat
@@ -567,7 +567,7 @@ def test_a_new_field_needs_the_sensor_to_turn():
     field[int(30 * FS):] = [0.0, 12.0, -38.0]
     for params, taken in (({}, False), ({"mag_new_angle": 0.0}, True)):
         _, accepted, _, _ = with_magnetometer(still, field, FS, params)
-        seen = int((30 + heading_params()["tau_mag_guard"]) * FS)
+        seen = int(30 * FS)
         assert accepted[-int(100 * FS):].all() == taken and not accepted[seen:int(49 * FS)].any()
 
 

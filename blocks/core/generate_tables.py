@@ -31,7 +31,7 @@ if __package__ in (None, ""):  # run as a script by the build: this clone's fold
     _spec.loader.exec_module(sys.modules["attitude_fmu"])
 
 from attitude_fmu.blocks.params import Param  # noqa: E402
-from attitude_fmu.blocks.tuning import ESTIMATORS, METHODS, uses  # noqa: E402
+from attitude_fmu.blocks.tuning import ESTIMATORS, GUARD_NOISE_MARGIN, METHODS, uses  # noqa: E402
 from attitude_fmu.systems.simulation.profile_table import GRAVITY, PROFILES  # noqa: E402
 
 HEADER = "af_params.h"
@@ -196,6 +196,11 @@ def header_text() -> str:
         "/* Every tuning parameter once, in the order of blocks.tuning.uses (the FMU's variables'); a value array of",
         " * AF_N_PARAMS doubles is indexed by AF_P_<name> (NaN: not given). */",
         f"#define AF_N_PARAMS {len(params)}",
+        "",
+        "/* tau_mag_guard unset: the heading guard's tightest tolerance in s.d. of the noise its low-pass leaves",
+        " * (blocks.tuning.GUARD_NOISE_MARGIN) */",
+        f"#define GUARD_NOISE_MARGIN {c_double(GUARD_NOISE_MARGIN)}",
+        "",
         "enum {",
         *(f"    AF_P_{_identifier(name)} = {i}," for i, name in enumerate(params)),
         "};",

@@ -10,10 +10,16 @@ second). Start-up: over the first tau_heading seconds every sample is used, uncl
 with the weight 1/n of a running mean, and the reference norm and dip are their running
 means (the first samples may come in motion, while the tilt is still settling). The field
 the heading follows and the guard judges is the tilt-compensated one (earth frame) through a
-first-order low-pass of tau_mag_guard (0.05 s): a field fixed in the earth frame passes
-unchanged, the sensor's noise is averaged (a fast, noisy magnetometer's samples would
-otherwise leave the tolerances by noise alone, and the clipped innovations would pull less
-than the error), and a disturbance is seen within tau_mag_guard. Then
+first-order low-pass of tau_mag_guard: a field fixed in the earth frame passes unchanged, the
+sensor's noise is averaged (a fast, noisy magnetometer's samples would otherwise leave the
+tolerances by noise alone, and the clipped innovations would pull less than the error), and a
+disturbance is seen within tau_mag_guard. Unset (the default), tau_mag_guard follows the noise
+the magnetometer shows: σ², the mean over the axes of (π/2)·(mean |Δ²m|)²/6 over the field's
+distinct samples so far (Δ² the second difference in the earth frame; a sample repeating the
+last, held, is left out), T their mean spacing, and tau_mag_guard the time that leaves white
+noise of σ per sample, σ²·T/(2·tau), the guard's tightest tolerance (min(mag_norm_tol,
+mag_dip_tol)·|m|) GUARD_NOISE_MARGIN standard deviations wide: no low-pass for a quiet
+magnetometer, none before a second difference. Then
 the guard against magnetic disturbances: a sample is used only while the field's norm
 and dip stay within tolerance of the reference, which is tracked slowly (tau_reference)
 over accepted samples; otherwise the heading is the gyro's. A new reference: a field
@@ -47,6 +53,7 @@ from attitude_fmu import _core
 from attitude_fmu.blocks.control_system import CStep, given, resting, sample_system, with_c_step
 
 STATE_NAMES = _core.HEADING_STATE_NAMES  # the state vector's entries: the C core's struct AfHeading
+GUARD_NOISE_MARGIN = _core.GUARD_NOISE_MARGIN  # blocks.tuning's, as the C core has it
 REST_INPUTS = (1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0)  # the stage's natural rest: q the identity, a field north (µT)
 
 

@@ -4,7 +4,9 @@ A homogeneous field seen from a turning sensor obeys ṁ = −ω × m (m freed o
 sensor frame). A magnetometer late by d sees ṁ(t) = −ω(t − d) × m ≈ −ω × m + d·ω̇ × m.
 Both sides low-passed to first order at 1/MAG_SPAN_S (the spans of the batch measurement,
 blocks.stages.delays) give y = L[ṁ + ω × m] = d·L[ω̇ × m] = d·J, and d is their least-squares
-ratio Σ y·J / Σ |J|², over the field samples the guard accepted, with a memory of
+ratio Σ y·J / Σ |J|², over the field samples the guard accepted, and accepted for
+MAG_DELAY_CLEAN_S before (three spans: the low-passes no longer hold a refused field,
+whose edge, a disturbance coming or going, would pass for a delay), with a memory of
 tau_mag_delay. Between two field samples (a slower magnetometer) the rate is summed:
 over the interval Δ, ṁ·Δ = m₁ − m₀, ∫ω × m ≈ (∫ω)×(m₀ + m₁)/2 and
 ∫ω̇ × m ≈ (ω₁ − ω₀)×(m₀ + m₁)/2, with ω the last step's rate.
@@ -20,6 +22,6 @@ changes) starts the estimate afresh.
 The estimate runs per step in the C core (blocks/core/stages/mag_delay.c), as part of the
 heading stage; its parameter is blocks.tuning.MAG_DELAY. The constants below are the core's.
 """
-from attitude_fmu._core import MAG_DELAY_MIN_S, MAG_DELAY_REACH_S, MAG_DELAY_SIGMAS, MAG_SPAN_S
+from attitude_fmu._core import MAG_DELAY_CLEAN_S, MAG_DELAY_MIN_S, MAG_DELAY_REACH_S, MAG_DELAY_SIGMAS, MAG_SPAN_S
 
-__all__ = ["MAG_SPAN_S", "MAG_DELAY_REACH_S", "MAG_DELAY_SIGMAS", "MAG_DELAY_MIN_S"]
+__all__ = ["MAG_SPAN_S", "MAG_DELAY_REACH_S", "MAG_DELAY_SIGMAS", "MAG_DELAY_MIN_S", "MAG_DELAY_CLEAN_S"]

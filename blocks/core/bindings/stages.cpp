@@ -182,10 +182,12 @@ void bind_stages(nb::module_ &m)
     add_names(heading_names, HARD_IRON_STATE_FIELDS, HARD_IRON_N_FIELDS, "hard_iron_");
     add_names(heading_names, MAG_DELAY_STATE_FIELDS, MAG_DELAY_N_FIELDS, "mag_delay_");
     m.attr("HEADING_STATE_NAMES") = state_names(heading_names, doubles<AfHeading>());
+    m.attr("GUARD_NOISE_MARGIN") = GUARD_NOISE_MARGIN;
     m.attr("MAG_SPAN_S") = MAG_SPAN_S;
     m.attr("MAG_DELAY_REACH_S") = MAG_DELAY_REACH_S;
     m.attr("MAG_DELAY_SIGMAS") = MAG_DELAY_SIGMAS;
     m.attr("MAG_DELAY_MIN_S") = MAG_DELAY_MIN_S;
+    m.attr("MAG_DELAY_CLEAN_S") = MAG_DELAY_CLEAN_S;
     m.def("heading_coefficients", [](nb::handle params, double Ts) {
         double resolved[AF_N_PARAMS];
         resolved_params(AF_STAGE_heading, params, resolved);

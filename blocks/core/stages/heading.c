@@ -16,8 +16,10 @@ int heading_coefficients(const double params[AF_N_PARAMS], double Ts, AfHeadingC
     coef->rate_reference = Ts / params[AF_P_tau_reference];
     coef->a_heading = 1.0 - exp(-Ts / params[AF_P_tau_heading]);
     coef->a_reference = 1.0 - exp(-Ts / params[AF_P_tau_reference]);
-    coef->rate_guard = Ts / params[AF_P_tau_mag_guard];
-    coef->a_guard = 1.0 - exp(-Ts / params[AF_P_tau_mag_guard]);
+    double tau_guard = params[AF_P_tau_mag_guard];
+    coef->guard_online = isnan(tau_guard) ? 1.0 : 0.0;
+    coef->rate_guard = isnan(tau_guard) ? 0.0 : Ts / tau_guard;
+    coef->a_guard = isnan(tau_guard) ? 0.0 : 1.0 - exp(-Ts / tau_guard);
     coef->norm_tol = params[AF_P_mag_norm_tol];
     coef->dip_tol = params[AF_P_mag_dip_tol];
     coef->clip = params[AF_P_heading_clip];
@@ -75,17 +77,63 @@ static double heading_error(Vec3 m, double psi)
     return error > PI ? error - 2.0 * PI : error < -PI ? error + 2.0 * PI : error;
 }
 
+/* noise_sample: a field sample into the noise measure: m_sensor as given (a repeat of the last is
+ * a held sample, left out), m in the earth frame */
+static void noise_sample(AfHeading *state, Vec3 m_sensor, Vec3 m)
+{
+    double *last = state->m_last;
+    int held = state->noise_n > 0.0 && m_sensor.x == last[0] && m_sensor.y == last[1] && m_sensor.z == last[2];
+    last[0] = m_sensor.x, last[1] = m_sensor.y, last[2] = m_sensor.z;
+    if (held)
+        return;
+    double now[3] = {m.x, m.y, m.z};
+    double(*prev)[3] = state->noise_m;
+    for (int i = 0; i < 3; i++) {
+        if (state->noise_n >= 2.0)
+            state->noise_abs[i] += fabs(now[i] - 2.0 * prev[0][i] + prev[1][i]);
+        prev[1][i] = prev[0][i], prev[0][i] = now[i];
+    }
+    if (state->noise_n >= 1.0)
+        state->noise_span += state->noise_gap;
+    state->noise_gap = 0.0;
+    state->noise_n += 1.0;
+}
+
+/* guard_rate: Ts/tau of the guard's low-pass with tau_mag_guard unset, for a field of norm norm:
+ * the tau that leaves white noise of s.d. sigma per sample, T steps apart (sigma^2 T Ts/(2 tau)),
+ * the guard's tightest tolerance GUARD_NOISE_MARGIN s.d. wide. sigma^2: the mean over the axes of
+ * (pi/2) (mean |second difference|)^2/6. Infinite (no low-pass) before a second difference. */
+static double guard_rate(const AfHeading *state, const AfHeadingCoef *coef, double norm)
+{
+    double count = state->noise_n - 2.0;
+    if (count < 1.0)
+        return INFINITY;
+    double mean_square = 0.0;
+    for (int i = 0; i < 3; i++)
+        mean_square += state->noise_abs[i] * state->noise_abs[i];
+    double sigma2 = (PI / 2.0) / 6.0 * mean_square / (3.0 * count * count);
+    double spacing = state->noise_span / (state->noise_n - 1.0);
+    double tolerance = (coef->norm_tol < coef->dip_tol ? coef->norm_tol : coef->dip_tol) * norm;
+    if (!(sigma2 > 0.0 && tolerance > 0.0 && spacing > 0.0)) /* a quiet field, no tolerance, or a state */
+        return INFINITY;                                     /* set from outside that says neither: as it comes */
+    return 2.0 * tolerance * tolerance / (spacing * GUARD_NOISE_MARGIN * GUARD_NOISE_MARGIN * sigma2);
+}
+
 /* field_sample: the field m (earth frame before the turn by psi_c about up, which leaves its norm,
  * horizontal norm and dip alone) taken into psi_c and the reference; whether it was used. What the
- * guard judges and the heading follows is m through a low-pass of tau_mag_guard, which averages a
- * fast magnetometer's noise (a field fixed in the earth frame passes it unchanged); the start-up
- * begins it at the sample. */
+ * guard judges and the heading follows is m through a low-pass (of tau_mag_guard, or unset of the
+ * time guard_rate gives), which averages a fast magnetometer's noise (a field fixed in the earth
+ * frame passes it unchanged); the start-up begins it at the sample. */
 static int field_sample(AfHeading *state, const AfHeadingCoef *coef, Quat q, Vec3 m)
 {
     double clip = coef->clip;
     double gap = state->gap;
     state->gap = 0.0;
-    double a_low = state->seen == 0.0 ? 1.0 : pull(gap, coef->rate_guard, coef->a_guard);
+    double a_low = 1.0;
+    if (state->seen > 0.0 && coef->guard_online == 0.0)
+        a_low = pull(gap, coef->rate_guard, coef->a_guard);
+    else if (state->seen > 0.0)
+        a_low = 1.0 - exp(-gap * guard_rate(state, coef, sqrt(m.x * m.x + m.y * m.y + m.z * m.z)));
     if (state->seen == 0.0)
         state->steps = 1.0;
     double *f = state->m_low;
@@ -161,6 +209,7 @@ static Quat about_up(double psi, Quat q)
 Quat heading_step(AfHeading *state, const AfHeadingCoef *coef, Quat q, Vec3 m_sensor, int *ok)
 {
     state->gap += 1.0;
+    state->noise_gap += 1.0;
     if (state->seen > 0.0)
         state->steps += 1.0;
     *ok = 0;
@@ -185,7 +234,9 @@ Quat heading_step(AfHeading *state, const AfHeadingCoef *coef, Quat q, Vec3 m_se
         }
         double steps = state->mag_delay.delay / Ts;
         Quat q_field = steps != 0.0 ? turned_back(q, turn, steps) : q;
-        *ok = field_sample(state, coef, q, quat_rotate(q_field, m_sensor)); /* turned by psi_c there */
+        Vec3 m_earth = quat_rotate(q_field, m_sensor);
+        noise_sample(state, m_sensor, m_earth);
+        *ok = field_sample(state, coef, q, m_earth); /* turned by psi_c there */
         if (online) {
             Vec3 rate = {turn.x / Ts, turn.y / Ts, turn.z / Ts};
             mag_delay_field_sample(&state->mag_delay, &coef->mag_delay, m_sensor, rate, *ok);

@@ -12,14 +12,19 @@
 #include "stages/mag_delay.h"
 
 /* The stage's own state: psi_c, the heading correction (rad); the field in the earth frame before
- * the turn by psi_c, through the low-pass of tau_mag_guard; the reference norm (the field's unit)
+ * the turn by psi_c, through the guard's low-pass; the reference norm (the field's unit)
  * and dip (rad); the field samples since the start-up began; the candidate field's norm,
  * dip, field samples and smallest |q.q0| since it began, q0 the orientation then; the steps since
  * the start-up began; the step the candidate began at; the steps since the last field sample; the
- * last step's orientation (0: none yet). The hard-iron fit's and the delay's states follow. */
+ * last step's orientation (0: none yet). The magnetometer's noise, measured over its distinct
+ * samples (a held sample repeats the last): the last sample as given; the last two distinct ones
+ * in the earth frame, the newest first; how many there were; the sums of the absolute second
+ * differences of those, per axis; the steps spanned from the first to the newest; the steps since
+ * the newest. The hard-iron fit's and the delay's states follow. */
 #define HEADING_FIELDS(X)                                                                                          \
     X(psi_c, ) X(m_low, [3]) X(ref_norm, ) X(ref_dip, ) X(seen, ) X(cand_norm, ) X(cand_dip, ) X(cand_n, )         \
-    X(cand_dot, ) X(cand_q0, [4]) X(steps, ) X(cand_start, ) X(gap, ) X(q_prev, [4])
+    X(cand_dot, ) X(cand_q0, [4]) X(steps, ) X(cand_start, ) X(gap, ) X(q_prev, [4]) X(m_last, [3])               \
+    X(noise_m, [2][3]) X(noise_n, ) X(noise_abs, [3]) X(noise_span, ) X(noise_gap, )
 typedef struct {
     HEADING_FIELDS(AF_DOUBLES)
     AfHardIron hard_iron;
@@ -31,7 +36,8 @@ extern const size_t HEADING_N_FIELDS;
 /* Its coefficients at one step (IMU sample) time Ts. */
 typedef struct {
     double rate_heading, rate_reference, rate_guard; /* Ts/tau_heading, Ts/tau_reference, Ts/tau_mag_guard */
-    double a_heading, a_reference, a_guard;          /* 1 - exp(-Ts/tau) of each */
+    double a_heading, a_reference, a_guard;          /* 1 - exp(-Ts/tau) of each (the guard's 0 where unset) */
+    double guard_online;                             /* 1: tau_mag_guard unset, from the noise (0: given) */
     double norm_tol, dip_tol, clip;                  /* mag_norm_tol, mag_dip_tol (rad), heading_clip (rad) */
     double new_steps;                                /* mag_new_time/Ts */
     double cos_half_turn;                            /* cos(mag_new_angle/2) */

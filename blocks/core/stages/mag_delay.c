@@ -54,7 +54,8 @@ void mag_delay_field_sample(AfMagDelay *state, const AfMagDelayCoef *coef, Vec3 
             y_lp[i] = lag * y_lp[i] + weight * dm[i];
             j_lp[i] = lag * j_lp[i] + weight * jv[i];
         }
-        if (use) {
+        state->clean = use ? state->clean + dt : 0.0;
+        if (use && state->clean >= MAG_DELAY_CLEAN_S) {
             double forget = one_step ? coef->forget : exp(-coef->rate * dt);
             double terms[4] = {y_lp[0] * j_lp[0] + y_lp[1] * j_lp[1] + y_lp[2] * j_lp[2],
                                j_lp[0] * j_lp[0] + j_lp[1] * j_lp[1] + j_lp[2] * j_lp[2],

@@ -11,13 +11,16 @@
 #define MAG_DELAY_REACH_S 0.1 /* s: the largest delay looked for */
 #define MAG_DELAY_SIGMAS 3.0  /* a delay is taken only this many standard errors or more from 0 */
 #define MAG_DELAY_MIN_S 5.0   /* s of accepted field samples in the sums before a delay is taken */
+#define MAG_DELAY_CLEAN_S 0.75 /* s: a sample enters the sums once the guard took every one this long (3 spans) */
 
 /* The estimate's state: the last field sample (sensor frame, hard iron removed), the rate at it
  * (rad/s), the integrated rate since it (rad), the time since it (s), 1 once there was one;
  * y = L[dm/dt + w x m] and j = L[dw/dt x m]; the sums of y.j dt, |j|^2 dt, |y|^2 dt and dt,
- * forgotten over tau_mag_delay; the delay in use (s). */
+ * forgotten over tau_mag_delay; the delay in use (s); the time since the guard last refused a
+ * field sample (s). */
 #define MAG_DELAY_FIELDS(X)                                                                                        \
-    X(last_m, [3]) X(last_w, [3]) X(turn, [3]) X(since, ) X(seen, ) X(y, [3]) X(j, [3]) X(sums, [4]) X(delay, )
+    X(last_m, [3]) X(last_w, [3]) X(turn, [3]) X(since, ) X(seen, ) X(y, [3]) X(j, [3]) X(sums, [4]) X(delay, )    \
+    X(clean, )
 typedef struct {
     MAG_DELAY_FIELDS(AF_DOUBLES)
 } AfMagDelay;
@@ -42,7 +45,9 @@ void mag_delay_turn(AfMagDelay *state, const AfMagDelayCoef *coef, Vec3 rotation
 void mag_delay_restart(AfMagDelay *state);
 
 /* field_sample: a field sample m (sensor frame, hard iron removed) with the step's rate w (rad/s);
- * the interval since the last one enters the estimate when use (the guard accepted it). */
+ * the interval since the last one enters the estimate when use (the guard accepted it) and the
+ * guard accepted every field sample over the last MAG_DELAY_CLEAN_S (the low-passes then hold
+ * no refused field: a disturbance's edge would pass for a delay). */
 void mag_delay_field_sample(AfMagDelay *state, const AfMagDelayCoef *coef, Vec3 m, Vec3 w, int use);
 
 #endif
