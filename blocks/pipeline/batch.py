@@ -14,9 +14,11 @@ from attitude_fmu.blocks.methods.registry import METHODS
 from attitude_fmu.blocks.methods.registry import method as get_method
 from attitude_fmu.blocks.pipeline.causal import Pipeline, State, Step, at, configure, run
 from attitude_fmu.blocks.stages import heading as heading_stage
+from attitude_fmu.blocks.stages import heading_choice
 from attitude_fmu.blocks.stages import scale_error
 from attitude_fmu.blocks.stages.delays import mag_delay
 from attitude_fmu.blocks.stages.gyro_offset import correct as correct_gyro
+from attitude_fmu.blocks.stages.gyro_offset import offset_estimate
 from attitude_fmu.blocks.stages.hard_iron import back_dated
 from attitude_fmu.blocks.stages.heading import with_magnetometer
 from attitude_fmu.blocks.stages.timing import carry_forward_rows, interval_ends, interval_means
@@ -37,7 +39,7 @@ class AttitudeEstimate:
     mag_offset: np.ndarray | None = None  # N×3, µT, hard-iron offset estimate (blocks.stages.hard_iron)
     mag_delay: np.ndarray | None = None  # N, s, the magnetometer's delay behind the gyro the heading allowed for
     mag_delay_source: str | None = None  # "given", "online" (blocks.stages.mag_delay) or "measured" (whole recording)
-    chosen: dict | None = None  # parameters chosen from the recording: {"scale_error": value} (blocks.stages.scale_error)
+    chosen: dict | None = None  # parameters chosen from the recording: {"scale_error": value[, "tau_heading": s]}
 
     @property
     def up(self) -> np.ndarray:
@@ -136,7 +138,9 @@ def estimate(
     scale_error (wiener with its local densities): unless given, chosen from the recording
     (blocks.stages.scale_error: of its candidates, the one whose estimate predicts the
     accelerometer best 0.5 s ahead through the gyro), online and offline alike; the value is
-    returned in `chosen`.
+    returned in `chosen`. With mag, unless tau_heading is given, the heading's time constant
+    then follows the gyro the choice found (blocks.stages.heading_choice), returned in
+    `chosen` too.
 
     offline: the batch-only additions (smoothed). The method's earth-frame filter runs
     forward, then backward over the forward estimate (for `wiener` the non-causal Wiener
@@ -161,7 +165,9 @@ def estimate(
     if scale_error.applies(method, dict(pipeline.params)):
         found = _chosen_scale_error(pipeline, step, gyr, acc, initial_gravity, threads)
         if found is not None:
-            chosen = {"scale_error": found}
+            chosen = {"scale_error": found[0]}
+            if pipeline.heading_params is not None and "tau_heading" not in pipeline.heading_params:
+                chosen["tau_heading"] = _chosen_tau_heading(pipeline, *found)
             pipeline = check_options(method, {**(params or {}), **chosen}, offline, gyro_offset, mag is not None,
                                      latency, gyr_samples, acc_samples)
             step = at(pipeline, 1.0 / fs)
@@ -176,16 +182,20 @@ def estimate(
 
 
 def _chosen_scale_error(pipeline: Pipeline, step: Step, gyr, acc, initial_gravity,
-                        threads: int | None) -> float | None:
-    """blocks.stages.scale_error's choice for the pipeline's method over the rows (None: the
-    recording is too short): the method alone, on the samples as the pipeline turns them
-    (its sample conventions, the gyro freed of its offset by the forward pass); candidates on
-    up to threads threads at once (None: a thread for each CPU the process may run on)."""
+                        threads: int | None) -> tuple[float, float, float] | None:
+    """blocks.stages.scale_error's choice for the pipeline's method over the rows, with the
+    gyro's mean square rate ⟨|ω|²⟩ (rad²/s²) it was made on and the mean variance of the
+    offset removed from it ((rad/s)², 0 with no offset stage) (None: the recording is too
+    short): the method alone, on the samples as the pipeline turns them (its sample
+    conventions, the gyro freed of its offset by the forward pass); candidates on up to
+    threads threads at once (None: a thread for each CPU the process may run on)."""
     fs = 1.0 / step.Ts
     gyr = interval_means(gyr) if pipeline.point_gyr else gyr
     acc = interval_ends(gyr, acc, step.Ts) if pipeline.mean_acc else acc
+    offset_variance = 0.0
     if pipeline.offset_params is not None:
-        gyr, _ = correct_gyro(gyr, acc, fs, pipeline.offset_params)
+        offset, variance = offset_estimate(gyr, acc, fs, pipeline.offset_params)
+        gyr, offset_variance = gyr - offset, float(np.mean(variance))
     own = dict(pipeline.params)
 
     def gravity(value: float) -> np.ndarray:
@@ -193,7 +203,18 @@ def _chosen_scale_error(pipeline: Pipeline, step: Step, gyr, acc, initial_gravit
                         gyro_offset=False, threads=1).gravity
 
     found = scale_error.choose(gyr, acc, fs, gravity, _core.cpus() if threads is None else threads)
-    return None if found is None else found[0]
+    return None if found is None else (found[0], float(np.mean(np.einsum("ij,ij->i", gyr, gyr))), offset_variance)
+
+
+def _chosen_tau_heading(pipeline: Pipeline, value: float, rate_ms: float, offset_variance: float) -> float:
+    """blocks.stages.heading_choice.time_constant for the scale_error value chosen on a gyro of
+    mean square rate rate_ms (rad²/s²) and offset variance offset_variance ((rad/s)², as
+    _chosen_scale_error returns them), with the pipeline's own parameters."""
+    method = get_method(pipeline.method)
+    own = method.resolve(dict(pipeline.params))
+    return heading_choice.time_constant(heading_stage.resolve(pipeline.heading_params)["tau_heading"], value,
+                                        method.resolve()["scale_error"], own["delta_n"], own["omega_m"], rate_ms,
+                                        offset_variance)
 
 
 def held_before(est: AttitudeEstimate, start: int) -> AttitudeEstimate:

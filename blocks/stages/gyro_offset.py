@@ -94,10 +94,18 @@ def offset_system(dt: float, params=None, name: str = "gyro_offset"):
 
 
 def correct(gyr, acc, fs: float, params=None, offline: bool = False):
-    """(corrected gyro, offset estimate), both N×3 rad/s, over a whole recording. offline:
-    the estimates of a forward and a backward pass in time (whose gyro is
-    blocks.filters.sensor_frame.time_reversed, its offset the negative), each axis weighted by
-    the inverse of its pass's variance: every sample's offset from all rests and motion."""
+    """(corrected gyro, offset estimate), both N×3 rad/s, over a whole recording (estimated
+    as offset_estimate does)."""
+    offset, _ = offset_estimate(gyr, acc, fs, params, offline)
+    return np.asarray(gyr, dtype=float) - offset, offset
+
+
+def offset_estimate(gyr, acc, fs: float, params=None, offline: bool = False):
+    """(offset estimate N×3 rad/s, its variance N×3 (rad/s)², per axis) over a whole
+    recording: gyr N×3 rad/s, acc N×3 m/s², fs Hz. offline: the estimates of a forward and a
+    backward pass in time (whose gyro is blocks.filters.sensor_frame.time_reversed, its offset
+    the negative), each axis weighted by the inverse of its pass's variance: every sample's
+    offset from all rests and motion, of the variance v_f·v_b/(v_f + v_b)."""
     gyr = np.ascontiguousarray(gyr, dtype=float)
     acc = np.ascontiguousarray(acc, dtype=float)
     coef = coefficients(resolve(params), 1.0 / fs)
@@ -112,4 +120,5 @@ def correct(gyr, acc, fs: float, params=None, offline: bool = False):
         back, back_variance = one_pass(time_reversed(gyr), np.ascontiguousarray(acc[::-1]))
         weight = back_variance[::-1] / (variance + back_variance[::-1])
         offset = weight * offset - (1.0 - weight) * back[::-1]
-    return gyr - offset, offset
+        variance = weight * variance
+    return offset, variance

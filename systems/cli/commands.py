@@ -517,10 +517,11 @@ def _estimate_one(args, path, out, prefix: str) -> None:
     if result.offset is not None:
         print(f"attitude: {prefix}gyro offset estimate at the end "
               f"({', '.join(f'{v:.3f}' for v in np.degrees(result.offset[-1]))}) °/s", file=sys.stderr)
-    if result.chosen is not None:
-        from attitude_fmu.blocks.stages.scale_error import chosen_text
+    for name, value in (result.chosen or {}).items():
+        from attitude_fmu.blocks.stages import heading_choice, scale_error
 
-        print(f"attitude: {prefix}{chosen_text(result.chosen['scale_error'])}", file=sys.stderr)
+        text = scale_error.chosen_text(value) if name == "scale_error" else heading_choice.chosen_text(value)
+        print(f"attitude: {prefix}{text}", file=sys.stderr)
     if result.mag_accepted is not None:
         sampled = np.isfinite(rec.mag).all(axis=1)  # rows where a slower magnetometer has a sample
         print(f"attitude: {prefix}magnetometer samples used for heading "
@@ -607,6 +608,10 @@ def cmd_evaluate(args) -> int:
         print(f"scale_error chosen from each recording (the best prediction of the accelerometer "
               f"{PREDICTION_HORIZON_S:g} s ahead; --param scale_error=V holds one): "
               + ", ".join(f"{name} {found['scale_error']:g}" for name, found in result["chosen"].items()))
+        heading = {name: found["tau_heading"] for name, found in result["chosen"].items() if "tau_heading" in found}
+        if heading:
+            print("tau_heading chosen from each recording (from the gyro the scale_error choice found; --param "
+                  "tau_heading=V holds one): " + ", ".join(f"{name} {tau:.4g} s" for name, tau in heading.items()))
     if "mag_used" in result:
         print("magnetometer samples the heading used over the movement (the guard refused the rest): "
               + ", ".join(f"{name} {100 * used:.0f} %" for name, used in result["mag_used"].items()))

@@ -300,10 +300,10 @@ def evaluate(paths, method: str = "wiener", params=None, offline: bool = False, 
     estimate's constant heading offset from the reference is removed before its heading error)
     or "magnetic" (the reference's north is magnetic north, as BROAD's: kept). by: the means over each group of recordings too, under "by_group"
     (by_group). "chosen": {name: {parameter: value}} holds what each estimate chose from its
-    recording (blocks.stages.scale_error), where it chose. "mag_used": {name: fraction} holds the
-    share of each recording's field samples over the movement that its heading used (the
-    disturbance guard refused the rest), where the heading came from the magnetometer; a
-    recording under MAG_USED_NOTE is noted."""
+    recording (blocks.stages.scale_error, blocks.stages.heading_choice), where it chose.
+    "mag_used": {name: fraction} holds the share of each recording's field samples over the
+    movement that its heading used (the disturbance guard refused the rest), where the heading
+    came from the magnetometer; a recording under MAG_USED_NOTE is noted."""
     jobs = jobs or Jobs(bar=progress)
     setup = Setup(method, params, offline, gyro_offset, use_mag, start_in_movement, read_options, latency,
                   gyr_samples, acc_samples, job_threads(jobs), align, reference_north)
