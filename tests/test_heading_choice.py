@@ -32,8 +32,8 @@ def test_the_time_constant_minimises_the_stated_error_variance(scale_error, rate
     finds it there), and the time constant returned is J's minimum at the scale error chosen;
     with no offset left it is tau_heading·√(q(0.005)/q(σ_s)); at 0.005 it is tau_heading itself."""
     tau_h = heading.resolve()["tau_heading"]
-    tau = time_constant(tau_h, scale_error, DATASHEET, DELTA_N, OMEGA_M, rate_ms, offset_variance)
     q = lambda s: 0.5 * (DELTA_N**2 + 4.0 * s**2 * rate_ms / OMEGA_M)
+    tau = time_constant(tau_h, 2.0 * q(DATASHEET), 2.0 * q(scale_error), offset_variance)
     r = 4.0 * offset_variance * tau_h**3 + q(DATASHEET) * tau_h**2
     best = lambda s: minimize_scalar(lambda t: _variance(t, s, rate_ms, offset_variance, r), bounds=(0.1, 1e3),
                                      method="bounded", options={"xatol": 1e-9}).x
@@ -42,7 +42,7 @@ def test_the_time_constant_minimises_the_stated_error_variance(scale_error, rate
     assert tau == pytest.approx(best(scale_error), rel=1e-6) and tau >= tau_h
     if offset_variance == 0.0:
         assert tau == pytest.approx(tau_h * math.sqrt(q(DATASHEET) / q(scale_error)), rel=1e-12)
-    assert time_constant(tau_h, DATASHEET, DATASHEET, DELTA_N, OMEGA_M, rate_ms, offset_variance) == tau_h
+    assert time_constant(tau_h, 2.0 * q(DATASHEET), 2.0 * q(DATASHEET), offset_variance) == tau_h
 
 
 def _heading_error(tau, fs, seconds, bias, r, seed):

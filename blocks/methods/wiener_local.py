@@ -33,10 +33,18 @@ from attitude_fmu import _core
 from attitude_fmu.blocks.filters.earth_filters import butterworth, omega_g
 
 
+def gyro_density(params, rate_ms: float) -> float:
+    """δn_eff² = δn² + σ_s²·4·⟨|ω|²⟩/ω_m ((rad/s)²/Hz, one-sided, per axis): the gyro's density the
+    local densities count at mean-square angular rate rate_ms (rad²/s², all axes together).
+    params: the method's resolved parameters."""
+    _, _, dn2, k_w, _, _, _, _ = _core.wiener_local_coefficients(params, 1.0)
+    return dn2 + k_w * rate_ms
+
+
 def settled_filter(params, rate_ms: float, delta_v: float):
     """Eq. 34 at the break frequency the local densities settle on for stationary motion
     of mean-square angular rate rate_ms (rad²/s², all axes together) and slosh delta_v
     (m/s/√Hz, eq. 14 band-limited at omega_m): the filter whose eq. 41 error the local
     filter has on such motion. params: the method's resolved parameters."""
-    _, g, dn2, k_w, _, dv2_min, _, _ = _core.wiener_local_coefficients(params, 1.0)
-    return butterworth(omega_g(math.sqrt(dn2 + k_w * rate_ms), math.sqrt(max(delta_v**2, dv2_min)), g))
+    _, g, _, _, _, dv2_min, _, _ = _core.wiener_local_coefficients(params, 1.0)
+    return butterworth(omega_g(math.sqrt(gyro_density(params, rate_ms)), math.sqrt(max(delta_v**2, dv2_min)), g))

@@ -10,6 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from attitude_fmu import _core
+from attitude_fmu.blocks.methods import wiener_local
 from attitude_fmu.blocks.methods.registry import METHODS
 from attitude_fmu.blocks.methods.registry import method as get_method
 from attitude_fmu.blocks.pipeline.causal import Pipeline, State, Step, at, configure, run
@@ -212,9 +213,12 @@ def _chosen_tau_heading(pipeline: Pipeline, value: float, rate_ms: float, offset
     _chosen_scale_error returns them), with the pipeline's own parameters."""
     method = get_method(pipeline.method)
     own = method.resolve(dict(pipeline.params))
-    return heading_choice.time_constant(heading_stage.resolve(pipeline.heading_params)["tau_heading"], value,
-                                        method.resolve()["scale_error"], own["delta_n"], own["omega_m"], rate_ms,
-                                        offset_variance)
+
+    def density(scale: float) -> float:
+        return wiener_local.gyro_density({**own, "scale_error": scale}, rate_ms)
+
+    return heading_choice.time_constant(heading_stage.resolve(pipeline.heading_params)["tau_heading"],
+                                        density(method.resolve()["scale_error"]), density(value), offset_variance)
 
 
 def held_before(est: AttitudeEstimate, start: int) -> AttitudeEstimate:

@@ -10,31 +10,28 @@ from __future__ import annotations
 import numpy as np
 
 
-def time_constant(tau_heading: float, scale_error: float, datasheet_scale_error: float, delta_n: float,
-                  omega_m: float, rate_ms: float, offset_variance: float) -> float:
+def time_constant(tau_heading: float, datasheet_density: float, density: float, offset_variance: float) -> float:
     """The heading's time constant (s) for a gyro whose scale error the recording showed
     (blocks.stages.scale_error's choice), where tau_heading (s) holds for the datasheet's.
 
     ψ_c blends the magnetometer's heading with the gyro's through a first-order filter of
     time constant τ, whose heading error has the variance J(τ) = P_b·τ² + q·τ/2 + r/(2τ): the
     gyro offset estimate's residual (variance P_b per axis) held over τ, the gyro's drift (a
-    random walk of rate q = δn_eff²/2, δn_eff² = δn² + 4·σ_s²·⟨|ω|²⟩/ω_m the one-sided density
-    of the Wiener filter's local densities), and the magnetometer's noise (density r). J is
-    least where 4·P_b·τ³ + q·τ² = r. r is the magnetometer's, the same for every gyro: the
-    one for which tau_heading is best with σ_s = datasheet_scale_error. The τ returned is best
-    with σ_s = scale_error (longer for a better gyro; tau_heading for the datasheet's).
+    random walk of rate q = δn_eff²/2, δn_eff² the one-sided density of the Wiener filter's
+    local densities, blocks.methods.wiener_local.gyro_density), and the magnetometer's noise
+    (density r). J is least where 4·P_b·τ³ + q·τ² = r. r is the magnetometer's, the same for
+    every gyro: the one for which tau_heading is best with the datasheet's scale error. The τ
+    returned is best with the one chosen (longer for a better gyro; tau_heading for the
+    datasheet's).
 
-    Parameters: delta_n (rad/s/√Hz), omega_m (rad/s) and datasheet_scale_error as the
-    method's; rate_ms ⟨|ω|²⟩ over the recording (rad²/s²); offset_variance P_b ((rad/s)², the
-    gyro-offset stage's variance averaged over the recording, 0 with no offset left)."""
-    if scale_error == datasheet_scale_error:
+    Parameters: datasheet_density and density, δn_eff² ((rad/s)²/Hz) with the datasheet's
+    scale error and with the one chosen, over the recording's motion; offset_variance P_b
+    ((rad/s)², the gyro-offset stage's variance averaged over the recording, 0 with no offset
+    left)."""
+    if density == datasheet_density:
         return tau_heading
-
-    def drift(s: float) -> float:
-        return 0.5 * (delta_n**2 + 4.0 * s**2 * rate_ms / omega_m)
-
-    r = 4.0 * offset_variance * tau_heading**3 + drift(datasheet_scale_error) * tau_heading**2
-    roots = np.roots([4.0 * offset_variance, drift(scale_error), 0.0, -r])  # one positive: the left rises with τ
+    r = 4.0 * offset_variance * tau_heading**3 + 0.5 * datasheet_density * tau_heading**2
+    roots = np.roots([4.0 * offset_variance, 0.5 * density, 0.0, -r])  # one positive: the left rises with τ
     return float(max(root.real for root in roots if abs(root.imag) <= 1e-9 * abs(root)))
 
 

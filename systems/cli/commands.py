@@ -517,11 +517,12 @@ def _estimate_one(args, path, out, prefix: str) -> None:
     if result.offset is not None:
         print(f"attitude: {prefix}gyro offset estimate at the end "
               f"({', '.join(f'{v:.3f}' for v in np.degrees(result.offset[-1]))}) °/s", file=sys.stderr)
-    for name, value in (result.chosen or {}).items():
+    if result.chosen is not None:
         from attitude_fmu.blocks.stages import heading_choice, scale_error
 
-        text = scale_error.chosen_text(value) if name == "scale_error" else heading_choice.chosen_text(value)
-        print(f"attitude: {prefix}{text}", file=sys.stderr)
+        for name, value in result.chosen.items():
+            text = scale_error.chosen_text(value) if name == "scale_error" else heading_choice.chosen_text(value)
+            print(f"attitude: {prefix}{text}", file=sys.stderr)
     if result.mag_accepted is not None:
         sampled = np.isfinite(rec.mag).all(axis=1)  # rows where a slower magnetometer has a sample
         print(f"attitude: {prefix}magnetometer samples used for heading "
