@@ -26,6 +26,8 @@ from attitude_fmu.blocks.params import (
 STANDARD_GRAVITY = 9.81  # m/s², the value the project uses for |g|
 NOMINAL_DELTA_V = 1.0  # m/s/√Hz: vigorous human motion (Rizun's Table 1), when delta_v is unset
 GUARD_NOISE_MARGIN = 5.0  # tau_mag_guard unset: the guard's tightest tolerance in s.d. of the noise left
+DRIFT_BLOCK_TAUS = 0.25  # the heading's drift estimate measures the field heading's noise over blocks of this × tau_heading
+DRIFT_SIGMAS = 4.0  # the heading follows the drift rate it estimates once the rate is this many s.d. from 0
 REST_NOISE_SIGMAS = 4.5  # the least rest_gyr in units of the gyro noise's per-axis s.d. through tau_short
 
 NOISE_PARAMS = (
@@ -103,6 +105,12 @@ METHODS = {
     ),
 }
 
+# parameters of the gyro-offset and the heading estimators both (a value given reaches both)
+GYRO_DENSITY = Param("delta_n", math.radians(0.1), "rad/s/√Hz", "gyro noise density, one-sided (datasheet): each "
+                     "sample's weight at rest, and the heading's random walk between field samples", **GYRO_NOISE)
+SIGMA_MOTION = Param("sigma_motion", math.radians(0.1), "rad/s", "uncertainty the offset tracking while moving settles "
+                     "on (per axis); the heading leaves a drift within it to its pull alone", **RATE_RAD_S)
+
 GYRO_OFFSET = (
     Param("rest_gyr", math.radians(2.0), "rad/s",
           "largest deviation of the gyro (through tau_short) from its low-pass at rest; at least "
@@ -116,14 +124,12 @@ GYRO_OFFSET = (
     Param("tau_lp", 0.5, "s", "time constant of the low-passes of the rest detection", **TIME_S),
     Param("tau_short", 0.02, "s", "time constant of the low-pass that takes white noise out of the samples the rest "
           "detection compares with its low-passes (human motion lies below 8 Hz)", **TIME_S),
-    Param("delta_n", math.radians(0.1), "rad/s/√Hz",
-          "gyro noise density, one-sided (datasheet): each sample's weight at rest", **GYRO_NOISE),
+    GYRO_DENSITY,
     Param("tau_acc", 3.0, "s", "time constant of the accelerometer low-pass in the gyro frame (motion tracking)",
           **TIME_S),
     Param("sigma_init", math.radians(0.5), "rad/s", "uncertainty of the offset before any rest (per axis)",
           **RATE_RAD_S),
-    Param("sigma_motion", math.radians(0.1), "rad/s", "uncertainty the tracking while moving settles on (per axis)",
-          **RATE_RAD_S),
+    SIGMA_MOTION,
     Param("tau_motion", 100.0, "s", "time in which the offset may drift by sigma_motion; 0: no tracking while moving",
           allow_zero=True, high=1e6),
 )
@@ -143,7 +149,13 @@ MAG_DELAY = (
           **TIME_S),
 )
 HEADING = (
-    Param("tau_heading", 10.0, "s", "time constant of the pull towards the magnetometer heading", **TIME_S),
+    Param("tau_heading", 10.0, "s", "time constant of the pull towards the magnetometer heading (for a gyro of "
+          "delta_n and no drift)", **TIME_S),
+    GYRO_DENSITY,
+    Param("heading_drift", math.radians(5.0), "rad/s", "largest drift of the gyro's heading the magnetometer may "
+          "show (a gyro offset along the vertical that the gyro-offset estimator cannot see): the prior s.d. of the "
+          "heading's drift rate; 0: no drift rate estimated", True, high=math.radians(4000.0)),
+    SIGMA_MOTION,
     Param("mag_norm_tol", 0.1, "1", "largest relative deviation of the field norm from its reference",
           low=1e-6, high=10.0),
     Param("mag_dip_tol", math.radians(5.0), "rad", "largest deviation of the dip angle from its reference",

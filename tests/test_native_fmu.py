@@ -371,7 +371,7 @@ def test_the_model_description_validates_and_matches_the_pythonfmu_fmu(fmus, md,
         return [(v.name, v.valueReference, v.type, v.causality, v.variability, v.initial, v.unit, str(v.start),
                  v.description) for v in description.modelVariables]
     assert table(md) == table(theirs)
-    assert len(md.modelVariables) == 74 and md.coSimulation.canGetAndSetFMUstate
+    assert len(md.modelVariables) == 75 and md.coSimulation.canGetAndSetFMUstate
     assert [u.name for u in md.unitDefinitions] == [u.name for u in theirs.unitDefinitions]
     assert md.guid != theirs.guid
 

@@ -497,7 +497,8 @@ def test_parameters_reach_every_running_stage_that_has_them():
     noise, offset_only, heading_only = {"delta_n": math.radians(0.3)}, {"rest_time": 3.0}, {"tau_heading": 5.0}
     est = estimate(gyr, acc, FS, params={**noise, **offset_only, **heading_only}, gyro_offset=True, mag=mag)
     corrected, offset = correct_gyro(gyr, acc, FS, {**noise, **offset_only})
-    quat = with_magnetometer(estimate(corrected, acc, FS, params=noise, gyro_offset=False).quat, mag, FS, heading_only)[0]
+    quat = with_magnetometer(estimate(corrected, acc, FS, params=noise, gyro_offset=False).quat, mag, FS,
+                             {**noise, **heading_only})[0]
     assert np.array_equal(est.offset, offset) and np.array_equal(est.quat, quat)
     assert np.abs(est.quat - estimate(gyr, acc, FS, gyro_offset=True, mag=mag).quat).max() > 1e-4
     with pytest.raises(ValueError, match=r"unknown parameter 'tau_heading' \(the method wiener: delta_n.*; "

@@ -96,7 +96,7 @@ def test_every_parameter_outside_its_range_is_refused_with_the_message_its_table
     (dict(method="tseng", params={"k_P": 1.0}, heading=True),
      "unknown parameter 'k_P' (the method tseng: none; the gyro-offset estimator: rest_gyr, rest_gyr_abs, rest_acc, "
      "rest_time, tau_lp, tau_short, delta_n, tau_acc, sigma_init, sigma_motion, tau_motion; the heading estimator: "
-     "tau_heading, mag_norm_tol, mag_dip_tol, tau_mag_guard, tau_reference, heading_clip, mag_new_time, "
+     "tau_heading, delta_n, heading_drift, sigma_motion, mag_norm_tol, mag_dip_tol, tau_mag_guard, tau_reference, heading_clip, mag_new_time, "
      "mag_new_angle, mag_delay, mag_cal_time, mag_cal_spread, mag_cal_tol, mag_cal_recent, tau_mag_delay)"),
     (dict(method="mahony", params={"scale_error": 0.0}),
      "unknown parameter 'scale_error' (the method mahony: k_P, k_I, g; the gyro-offset estimator: rest_gyr, "
@@ -108,7 +108,7 @@ def test_every_parameter_outside_its_range_is_refused_with_the_message_its_table
      "s (blocks.methods.wiener_local); 1, or omega_g, omega_c or delta_v given: the stationary filter)"),
     (dict(params={"mag_cal_time": -1.0, "tau_heading": 1e-320}, heading=True),
      "parameter tau_heading = 9.99989e-321 s is outside its plausible range [1e-09, 1e+12] s (time constant of the "
-     "pull towards the magnetometer heading)"),
+     "pull towards the magnetometer heading (for a gyro of delta_n and no drift))"),
     (dict(method="luinge", params={"tilt_sd": -math.inf}, heading=True, gyro_offset=False),
      "parameter tilt_sd must be a finite positive number ([1e-06, 3.14159] rad), got -inf"),
     (dict(method="wiener", params={"omega_c": 0.05}),
@@ -124,7 +124,7 @@ def test_every_parameter_outside_its_range_is_refused_with_the_message_its_table
      "default sqrt(g·delta_n/delta_v), eq. 25)"),
     (dict(method="tseng", params={"sigma_motion": 1e200}),
      "parameter sigma_motion = 1e+200 rad/s is outside its plausible range [1e-06, 69.8132] rad/s (uncertainty the "
-     "tracking while moving settles on (per axis))"),
+     "offset tracking while moving settles on (per axis); the heading leaves a drift within it to its pull alone)"),
     (dict(method="tseng", params={"mag_new_time": 1e307}, heading=True, gyro_offset=False),
      "parameter mag_new_time = 1e+307 s is outside its plausible range [1e-09, 1e+12] s (how long a field outside the "
      "reference's tolerance must stay steady to replace it)"),

@@ -31,7 +31,8 @@ if __package__ in (None, ""):  # run as a script by the build: this clone's fold
     _spec.loader.exec_module(sys.modules["attitude_fmu"])
 
 from attitude_fmu.blocks.params import Param  # noqa: E402
-from attitude_fmu.blocks.tuning import ESTIMATORS, GUARD_NOISE_MARGIN, METHODS, uses  # noqa: E402
+from attitude_fmu.blocks.tuning import (DRIFT_BLOCK_TAUS, DRIFT_SIGMAS, ESTIMATORS, GUARD_NOISE_MARGIN,  # noqa: E402
+                                         METHODS, uses)
 from attitude_fmu.systems.simulation.profile_table import GRAVITY, PROFILES  # noqa: E402
 
 HEADER = "af_params.h"
@@ -200,6 +201,12 @@ def header_text() -> str:
         "/* tau_mag_guard unset: the heading guard's tightest tolerance in s.d. of the noise its low-pass leaves",
         " * (blocks.tuning.GUARD_NOISE_MARGIN) */",
         f"#define GUARD_NOISE_MARGIN {c_double(GUARD_NOISE_MARGIN)}",
+        "/* the block of the heading's drift estimate's measure of the field heading's noise, in tau_heading",
+        " * (blocks.tuning.DRIFT_BLOCK_TAUS) */",
+        f"#define DRIFT_BLOCK_TAUS {c_double(DRIFT_BLOCK_TAUS)}",
+        "/* the heading follows its drift rate's estimate once it is this many s.d. from 0",
+        " * (blocks.tuning.DRIFT_SIGMAS) */",
+        f"#define DRIFT_SIGMAS {c_double(DRIFT_SIGMAS)}",
         "",
         "enum {",
         *(f"    AF_P_{_identifier(name)} = {i}," for i, name in enumerate(params)),

@@ -12,6 +12,16 @@ static const double PI = 3.14159265358979323846;
 
 int heading_coefficients(const double params[AF_N_PARAMS], double Ts, AfHeadingCoef *coef)
 {
+    double q = 0.5 * params[AF_P_delta_n] * params[AF_P_delta_n];
+    coef->Ts = Ts;
+    coef->q_psi = q;
+    coef->r_drift = params[AF_P_tau_heading] * params[AF_P_tau_heading] * q;
+    coef->q_rate = params[AF_P_sigma_motion] * params[AF_P_sigma_motion] / params[AF_P_tau_reference];
+    coef->block_steps = fmax(1.0, round(DRIFT_BLOCK_TAUS * params[AF_P_tau_heading] / Ts));
+    coef->a_block = coef->block_steps * Ts / params[AF_P_tau_reference];
+    coef->rate_max = params[AF_P_heading_drift];
+    coef->P_rate = coef->rate_max * coef->rate_max;
+    coef->rate_left = params[AF_P_sigma_motion];
     coef->rate_heading = Ts / params[AF_P_tau_heading];
     coef->rate_reference = Ts / params[AF_P_tau_reference];
     coef->a_heading = 1.0 - exp(-Ts / params[AF_P_tau_heading]);
@@ -35,6 +45,110 @@ void heading_initial_state(AfHeading *state)
 {
     memset(state, 0, sizeof *state);
     state->cand_dot = 1.0;
+}
+
+/* followed: the drift rate psi_c follows (rad/s): the part of the estimate beyond rate_left (the pull
+ * follows that alone) and its s.d., once it is DRIFT_SIGMAS of its s.d. from 0 */
+static double followed(double rate, double var_rate, const AfHeadingCoef *coef)
+{
+    double sd = sqrt(var_rate), left = coef->rate_left > sd ? coef->rate_left : sd;
+    if (!(fabs(rate) > DRIFT_SIGMAS * sd))
+        return 0.0;
+    return rate > left ? rate - left : rate < -left ? rate + left : 0.0;
+}
+
+/* restart: the drift estimate begun afresh from the next block (its level unknown, blocks = 0); its
+ * rate kept, or with afresh set (a field that was not what it seemed) learnt anew with its noise measure */
+static void restart(AfHeading *state, const AfHeadingCoef *coef, int afresh)
+{
+    state->blocks = 0.0, state->blk_n = 0.0, state->blk_sum = 0.0, state->blk_steps = 0.0, state->unwrapped = 0.0;
+    if (afresh) {
+        state->rate = 0.0;
+        state->var_rate = coef->P_rate;
+        state->d2[1] = 0.0;
+        state->follow = 0.0;
+    }
+}
+
+/* wrapped: an angle (rad) within (-3 pi, 3 pi) brought within [-pi, pi] */
+static double wrapped(double a)
+{
+    return a > PI ? a - 2.0 * PI : a < -PI ? a + 2.0 * PI : a;
+}
+
+/* second_difference: the |second difference| d2 (rad) of three block means into the measure at
+ * measure[0] of measure[1] such differences: taken where larger than the measure, otherwise into its
+ * running mean, a difference's weight at the least a */
+static void second_difference(double measure[2], double d2, double a)
+{
+    measure[1] += 1.0;
+    double w = 1.0 / measure[1] > a ? 1.0 / measure[1] : a;
+    measure[0] = d2 > measure[0] ? d2 : measure[0] + w * (d2 - measure[0]);
+}
+
+/* the noise density (rad^2 s) a measure of mean |second difference| d2 (rad) over blocks of t s gives */
+static double density(double d2, double t)
+{
+    return (PI / 2.0) / 6.0 * d2 * d2 * t;
+}
+
+/* drift_block: a block's mean field heading (unwrapped, rad) into the drift estimate; differences of
+ * headings taken within [-pi, pi] (a field that turned a full circle meanwhile ends where it began). The
+ * noise measure first: the |second difference| of the last three block means (a constant drift has none),
+ * taken where larger than the measure (errors that come up count at once, before the block is used),
+ * otherwise into its running mean, which forgets over tau_reference once that many blocks have
+ * passed. White noise of density S (rad^2 s) gives block means of variance S/T_b and a mean
+ * |second difference| of sqrt(6 S/T_b 2/pi): the measure's S, or r_drift where larger, is the
+ * block mean's noise. Then a Kalman filter of the level (the heading at the block's middle) and
+ * the drift rate: the level a random walk of the gyro's noise, the rate one of sigma_motion over
+ * tau_reference; from the third block of a start on (the noise measured) past the heading's start-up
+ * (start set: within it), its level set by the block before. */
+static void drift_block(AfHeading *state, const AfHeadingCoef *coef, double mean, double steps, int start)
+{
+    double *prev = state->blk_mean, P[3] = {state->var_level, state->covariance, state->var_rate};
+    double dt = 0.5 * (steps + state->blk_last) * coef->Ts; /* from the last block's middle to this one's */
+    state->blk_last = steps;
+    if (state->blocks >= 2.0)
+        second_difference(state->d2, fabs(remainder(mean - 2.0 * prev[1] + prev[0], 2.0 * PI)), coef->a_block);
+    if (state->blocks >= 2.0 && !start) {
+        double s = fmax(coef->r_drift, density(state->d2[0], coef->block_steps * coef->Ts));
+        double r = s / (steps * coef->Ts);
+        state->level += state->rate * dt;
+        P[0] += dt * (2.0 * P[1] + dt * P[2]) + coef->q_psi * dt;
+        P[1] += dt * P[2];
+        P[2] += coef->q_rate * dt;
+        double inv_s = 1.0 / (P[0] + r), e = remainder(mean - state->level, 2.0 * PI);
+        double k0 = P[0] * inv_s, k1 = P[1] * inv_s, p0 = P[0], p1 = P[1];
+        state->level += k0 * e;
+        state->rate += k1 * e;
+        P[0] -= k0 * p0;
+        P[1] -= k0 * p1;
+        P[2] -= k1 * p1;
+        if (fabs(state->rate) > coef->rate_max) /* no larger than the drift the parameter allows */
+            state->rate = state->rate > 0.0 ? coef->rate_max : -coef->rate_max;
+    } else { /* the level from this block (within the start-up, or of the first two blocks) */
+        state->level = mean;
+        P[0] = coef->r_drift / (steps * coef->Ts), P[1] = 0.0;
+    }
+    state->var_level = P[0], state->covariance = P[1], state->var_rate = P[2];
+    state->follow = followed(state->rate, P[2], coef);
+    prev[0] = prev[1], prev[1] = mean;
+    state->blocks += 1.0;
+}
+
+/* field_noise: the field heading h (rad) of an accepted sample gap steps after the last: unwrapped from
+ * sample to sample, into the block's mean, each block of coef->block_steps into the drift estimate */
+static void field_noise(AfHeading *state, const AfHeadingCoef *coef, double h, double gap, int start)
+{
+    state->unwrapped += state->blk_n > 0.0 || state->blocks > 0.0 ? wrapped(h - state->h_last) : 0.0;
+    state->h_last = h;
+    state->blk_sum += state->unwrapped;
+    state->blk_n += 1.0;
+    state->blk_steps += gap;
+    if (state->blk_steps < coef->block_steps)
+        return;
+    drift_block(state, coef, state->blk_sum / state->blk_n, state->blk_steps, start);
+    state->blk_n = 0.0, state->blk_sum = 0.0, state->blk_steps = 0.0;
 }
 
 static int steady(double norm, double dip, double ref_norm, double ref_dip, double norm_tol, double dip_tol)
@@ -68,13 +182,6 @@ static int new_reference(AfHeading *state, const AfHeadingCoef *coef, Quat q, do
     state->cand_start = state->steps;
     quat_store(q, state->cand_q0);
     return 0;
-}
-
-/* heading_error: atan2(x, y) of the field m turned about up by psi (rad): the heading error's negative */
-static double heading_error(Vec3 m, double psi)
-{
-    double error = atan2(m.x, m.y) - psi; /* within (-2 pi, 2 pi): psi is kept within [-pi, pi] */
-    return error > PI ? error - 2.0 * PI : error < -PI ? error + 2.0 * PI : error;
 }
 
 /* noise_sample: a field sample into the noise measure: m_sensor as given (a repeat of the last is
@@ -153,15 +260,19 @@ static int field_sample(AfHeading *state, const AfHeadingCoef *coef, Quat q, Vec
             state->cand_n = 0.0;
         } else if (new_reference(state, coef, q, norm, dip)) {
             state->seen = 1.0, state->steps = 1.0, start = 1; /* a proven field: start afresh */
+            restart(state, coef, 0);
         }
     }
+    double h = atan2(m.x, m.y); /* the field's heading: psi - h the heading error (psi within [-pi, pi]) */
+    if (ok || start)
+        field_noise(state, coef, h, gap, start);
     if (start) { /* running means, every sample */
         ok = 1;
-        state->psi_c += heading_error(m, state->psi_c) / state->seen;
+        state->psi_c += wrapped(h - state->psi_c) / state->seen;
         state->ref_norm += (norm - state->ref_norm) / state->seen;
         state->ref_dip += (dip - state->ref_dip) / state->seen;
     } else if (ok) { /* first-order pulls over the time since the last field sample */
-        double error = heading_error(m, state->psi_c);
+        double error = wrapped(h - state->psi_c);
         double low = error > -clip ? error : -clip;
         state->psi_c += pull(gap, coef->rate_heading, coef->a_heading) * (low < clip ? low : clip);
         double a_reference = pull(gap, coef->rate_reference, coef->a_reference);
@@ -223,6 +334,9 @@ Quat heading_step(AfHeading *state, const AfHeadingCoef *coef, Quat q, Vec3 m_se
         turn = step_turn(q_prev, q);
     if (online)
         mag_delay_turn(&state->mag_delay, &coef->mag_delay, turn);
+    if (!(fabs(q_prev.w) + fabs(q_prev.x) + fabs(q_prev.y) + fabs(q_prev.z) > 0.0)) /* the first step */
+        restart(state, coef, 1);
+    state->psi_c += state->follow * Ts;
     double n2 = m_sensor.x * m_sensor.x + m_sensor.y * m_sensor.y + m_sensor.z * m_sensor.z;
     if (isfinite(n2) && n2 > 0.0) { /* a field sample (not NaN: missing, not all 0: none) */
         int proven;
@@ -230,6 +344,7 @@ Quat heading_step(AfHeading *state, const AfHeadingCoef *coef, Quat q, Vec3 m_se
                                   coef->new_steps, &proven);
         if (proven) { /* a field freed of (or back without) an offset: start afresh from it */
             state->seen = 0.0;
+            restart(state, coef, 1);
             mag_delay_restart(&state->mag_delay);
         }
         double steps = state->mag_delay.delay / Ts;
