@@ -263,7 +263,8 @@ def test_every_profile_at_the_edges_of_its_ranges_gives_finite_samples_for_a_lon
 
 SENSOR_ERRORS = dict(delta_n=math.radians(0.1), gyr_offset=(0.01, -0.02, 0.03),
                      gyr_scale=((0.01, -0.002, 0.0), (0.003, 0.0, 0.005), (0.0, 0.004, -0.02)), acc_noise=0.01,
-                     acc_offset=(0.1, -0.2, 0.3), mag_noise=0.5, mag_offset=(8.0, -3.0, 12.0))
+                     acc_offset=(0.1, -0.2, 0.3), mag_noise=0.5, mag_offset=(8.0, -3.0, 12.0),
+                     mag_soft_iron=((0.05, 0.02, -0.01), (0.02, -0.06, 0.03), (-0.01, 0.03, 0.04)))
 
 
 def _late(x, samples):
@@ -281,7 +282,7 @@ def _late(x, samples):
 def test_the_sensor_measures_eqs_1_2_with_its_noise_streams_through_its_delay_line(latency):
     """gyr = (I + S)·ω + δ_n·√(fs/2)·z[0:3] + b, acc = f + σ_a·√(fs/2)·z[3:6] + b_a with z the
     stream SENSOR, ω and f latency late (between samples: linear between the two it falls
-    between); mag = m + σ_m·√(fs/2)·z_m + b_m with z_m the stream MAGNETOMETER (no delay)."""
+    between); mag = (I + S_m)·m + σ_m·√(fs/2)·z_m + b_m with z_m the stream MAGNETOMETER (no delay)."""
     imu = ImuModel(**SENSOR_ERRORS, latency=latency)
     motion = HumanMotion().generate(20.0, FS, seed=3)
     gyr, acc = imu.apply(motion, seed=4)
@@ -291,7 +292,8 @@ def test_the_sensor_measures_eqs_1_2_with_its_noise_streams_through_its_delay_li
     S = np.array(SENSOR_ERRORS["gyr_scale"])
     expected_gyr = omega + omega @ S.T + SENSOR_ERRORS["delta_n"] * scale * z[:, 0:3] + SENSOR_ERRORS["gyr_offset"]
     expected_acc = f + SENSOR_ERRORS["acc_noise"] * scale * z[:, 3:6] + SENSOR_ERRORS["acc_offset"]
-    expected_mag = motion.mag + SENSOR_ERRORS["mag_noise"] * scale * z_mag + SENSOR_ERRORS["mag_offset"]
+    soft = np.array(SENSOR_ERRORS["mag_soft_iron"])
+    expected_mag = motion.mag + motion.mag @ soft.T + SENSOR_ERRORS["mag_noise"] * scale * z_mag + SENSOR_ERRORS["mag_offset"]
     assert np.abs(gyr - expected_gyr).max() < 1e-12 * np.abs(expected_gyr).max()
     assert np.abs(acc - expected_acc).max() < 1e-12 * np.abs(expected_acc).max()
     assert np.abs(mag - expected_mag).max() < 1e-12 * np.abs(expected_mag).max()
@@ -315,6 +317,9 @@ def test_a_sensor_a_whole_number_of_samples_late_shifts_the_motion_exactly():
     ({"gyr_scale": ((0.0, 0.0, 0.0), (0.0, 0.0, math.nan), (0.0, 0.0, 0.0))},
      "gyr_scale must be 3×3 finite numbers, got ((0.0, 0.0, 0.0), (0.0, 0.0, nan), (0.0, 0.0, 0.0))"),
     ({"gyr_scale": ((0.0, 0.0), (0.0, 0.0))}, "gyr_scale must be 3×3 finite numbers, got ((0.0, 0.0), (0.0, 0.0))"),
+    ({"mag_soft_iron": ((0.0, 0.0, 0.0), (math.inf, 0.0, 0.0), (0.0, 0.0, 0.0))},
+     "mag_soft_iron must be 3×3 finite numbers, got ((0.0, 0.0, 0.0), (inf, 0.0, 0.0), (0.0, 0.0, 0.0))"),
+    ({"mag_soft_iron": (0.1, 0.0, 0.0)}, "mag_soft_iron must be 3×3 finite numbers, got (0.1, 0.0, 0.0)"),
 ])
 def test_the_sensor_refuses_bad_parameters_in_its_words(values, message):
     with pytest.raises(ValueError) as refused:

@@ -286,7 +286,7 @@ void bind_sensor(nb::module_ &m)
             throw nb::value_error(message);
         },
         nb::arg("name"), nb::arg("value"),
-        "ValueError: the vector parameter name (gyr_offset, acc_offset, mag_offset, gyr_scale) is not "
+        "ValueError: the vector parameter name (gyr_offset, acc_offset, mag_offset, gyr_scale, mag_soft_iron) is not "
         "finite numbers of its shape, given value.");
     m.def(
         "imu_measure",
