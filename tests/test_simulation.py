@@ -441,7 +441,8 @@ def test_the_sensor_measures_eqs_1_2_with_its_noise_streams_through_its_delay_li
     expected_gyr = omega + omega @ S.T + SENSOR_ERRORS["delta_n"] * scale * z[:, 0:3] + SENSOR_ERRORS["gyr_offset"]
     expected_acc = f + SENSOR_ERRORS["acc_noise"] * scale * z[:, 3:6] + SENSOR_ERRORS["acc_offset"]
     soft = np.array(SENSOR_ERRORS["mag_soft_iron"])
-    expected_mag = motion.mag + motion.mag @ soft.T + SENSOR_ERRORS["mag_noise"] * scale * z_mag + SENSOR_ERRORS["mag_offset"]
+    expected_mag = (motion.mag + motion.mag @ soft.T + SENSOR_ERRORS["mag_noise"] * scale * z_mag
+                    + SENSOR_ERRORS["mag_offset"])
     assert np.abs(gyr - expected_gyr).max() < 1e-12 * np.abs(expected_gyr).max()
     assert np.abs(acc - expected_acc).max() < 1e-12 * np.abs(expected_acc).max()
     assert np.abs(mag - expected_mag).max() < 1e-12 * np.abs(expected_mag).max()

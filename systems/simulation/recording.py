@@ -1,5 +1,5 @@
 """Recordings made by the simulator (`attitude simulate`): a rest, then human motion
-(systems.simulation.motion.HumanMotion), measured by a sensor of a datasheet's figures at any
+(systems.simulation.motion.HumanMotion) or another motion profile, measured by a sensor of a datasheet's figures at any
 rate, with the motion's exact orientation as the reference, so that `attitude evaluate` scores
 them as it scores a lab's recordings. The sensors' table loads without python-control (the command
 line's help lists it); the simulation loads it when it runs."""
@@ -106,23 +106,26 @@ SENSORS = {
 
 def simulate_recording(fs: float, duration: float, rest: float = 10.0, sensor: Sensor = SENSORS["consumer"],
                        motion: dict | None = None, seed: int = 0, mag: bool = True,
-                       name: str = "simulated") -> Recording:
-    """A recording at fs (Hz): rest seconds still and level, then duration seconds of
-    human motion (the parameters of profile "human" updated by DEFAULT_MOTION, then by
-    motion), measured by sensor
+                       name: str = "simulated", motion_profile: str = "human") -> Recording:
+    """A recording at fs (Hz): rest seconds still in the pose the motion starts from (level
+    for the human motion), then duration seconds of the motion profile motion_profile (its
+    parameters updated by motion; the human motion's first by DEFAULT_MOTION), measured by sensor
     (its errors drawn from seed; the motion's noise from its stream of seed, the sensor's
     and the magnetometer's from theirs of seed + 1). The reference is the motion's orientation, the movement flag
     0 over the rest; with mag, the magnetometer sees the simulation's earth field. Samples
     beyond the sensor's range read its full scale; notes count them per sensor."""
+    from scipy.spatial.transform import Rotation
+
     from attitude_fmu.systems.simulation.motion import Motion, profile
 
-    human = profile("human").motion({**DEFAULT_MOTION, **(motion or {})})
+    defaults = DEFAULT_MOTION if motion_profile == "human" else {}
+    moves = profile(motion_profile).motion({**defaults, **(motion or {})})
     still = round(rest * fs)
-    moving = human.generate(duration, fs, seed)
-    g = human.g
-    truth = Motion(fs, np.vstack([np.tile([1.0, 0.0, 0.0, 0.0], (still, 1)), moving.quat]),
+    moving = moves.generate(duration, fs, seed)
+    start = Rotation.from_quat(moves.start_quat(), scalar_first=True)
+    truth = Motion(fs, np.vstack([np.tile(start.as_quat(scalar_first=True), (still, 1)), moving.quat]),
                    np.vstack([np.zeros((still, 3)), moving.gyr]),
-                   np.vstack([np.tile([0.0, 0.0, g], (still, 1)), moving.acc]))
+                   np.vstack([np.tile(start.inv().apply([0.0, 0.0, moves.g]), (still, 1)), moving.acc]))
     imu = sensor.model(seed)
     gyr, acc = imu.apply(truth, seed + 1)
     notes = []
