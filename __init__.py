@@ -4,7 +4,8 @@ What a script needs, by task (each name's own docstring has its units and defaul
 
 - estimate over arrays: `estimate` → `AttitudeEstimate` (quat, up, offset, …); the
   methods by name: `METHODS`; per sample, as a co-simulation step: `OnlineEstimator`;
-- recordings: `read_recording` → `Recording`, `write_estimate`;
+- recordings: `read_recording` → `Recording`, `write_estimate`; simulated ones that reproduce
+  failure modes of other labs' recordings: `SCENARIOS`, `scenario` (`.recording()`);
 - python-control blocks: `estimator_system` (any method), `sensor_frame_system` (any
   earth-frame filter carried into the sensor frame), the earth-frame filters `butterworth`,
   `wiener_band_limited`, `first_order` and `omega_g`, Tseng's transfer functions under
@@ -63,6 +64,8 @@ _API = {
     "HumanMotion": "systems.simulation.motion",
     "profile": "systems.simulation.motion",
     "ImuModel": "systems.simulation.sensor_model",
+    "SCENARIOS": "systems.simulation.scenarios",
+    "scenario": "systems.simulation.scenarios",
     "rms_attitude_error": "blocks.filters.accuracy",
     "mean_square_error": "blocks.filters.accuracy",
     "error_spectrum": "blocks.filters.accuracy",
@@ -141,4 +144,5 @@ if TYPE_CHECKING:  # the same names for type checkers and editors
         simulate_closed_loop,
     )
     from .systems.simulation.motion import HumanMotion, profile
+    from .systems.simulation.scenarios import SCENARIOS, scenario
     from .systems.simulation.sensor_model import ImuModel

@@ -3,7 +3,9 @@
 A page's line `<!-- generated: cli -->` becomes the reference of every `attitude` command,
 from its argparse parser; `<!-- generated: api -->` the public API, from the docstrings
 (mkdocstrings); `<!-- generated: fmus -->` the variables of every FMU, from the model
-descriptions a build writes (built once per docs build, into a temporary folder).
+descriptions a build writes (built once per docs build, into a temporary folder);
+`<!-- generated: scenarios -->` the table of `attitude simulate`'s scenarios
+(systems/simulation/scenarios.py).
 """
 from __future__ import annotations
 
@@ -82,6 +84,23 @@ def api_reference() -> str:
     return "\n\n".join(f"::: attitude_fmu.{attitude_fmu._API[name]}.{name}" for name in attitude_fmu.__all__)
 
 
+def scenarios_reference() -> str:
+    """A table of the simulator's scenarios: name, description, motion, rate and durations, seed, sensor."""
+    from attitude_fmu.systems.simulation.scenarios import SCENARIOS
+
+    out = ["| scenario | what it stands for | motion | rate | rest, motion | seed | sensor |", "|---|---|---|---|---|---|---|"]
+    for name, s in SCENARIOS.items():
+        motion = f"`{s.profile}`" + "".join(f", {k}={v:g}" for k, v in s.motion.items())
+        f = s.sensor
+        direction = "drawn" if f.gyro_offset_direction is None else f"along {tuple(f.gyro_offset_direction)}"
+        sensor = (f"gyro {f.gyro_noise_dps:g} °/s/√Hz, offset {f.gyro_offset_dps:.3g} °/s {direction}, scale error "
+                  f"{f.gyro_scale_error:g}; magnetometer {f.mag_noise:g} µT/√Hz, soft iron {f.mag_soft_iron:g} rms, "
+                  f"hard iron {f.mag_hard_iron_ut:g} µT")
+        out.append(f"| `{name}` | {_cell(s.description)} | {_cell(motion)} | {s.fs:g} Hz | {s.rest:g} s, "
+                   f"{s.duration:g} s | {s.seed} | {_cell(sensor)} |")
+    return "\n".join(out)
+
+
 @lru_cache(maxsize=1)
 def _built_fmus() -> Path:
     """A folder with every FMU, as python build_fmu.py writes them."""
@@ -100,6 +119,8 @@ def on_page_markdown(markdown: str, page, config, files) -> str:
         markdown = markdown.replace(MARKER.format("cli"), cli_reference(build_parser()))
     if MARKER.format("api") in markdown:
         markdown = markdown.replace(MARKER.format("api"), api_reference())
+    if MARKER.format("scenarios") in markdown:
+        markdown = markdown.replace(MARKER.format("scenarios"), scenarios_reference())
     if MARKER.format("fmus") in markdown:
         markdown = markdown.replace(MARKER.format("fmus"), fmu_reference(_built_fmus()))
     return markdown

@@ -23,7 +23,7 @@ from attitude_fmu.systems.simulation.sensor_model import ImuModel
 class ImuSensor(ProjectSlave):
     author = "attitude-fmu"
     description = ("IMU sensor model: gyro noise density, offset, scale and misalignment, accelerometer noise and "
-                   "offset, magnetometer noise and hard iron")
+                   "offset, magnetometer noise, hard and soft iron")
     internal_state = ("rng", "mag_rng", "delay", "step_size")
 
     def __init__(self, **kwargs):
@@ -40,6 +40,7 @@ class ImuSensor(ProjectSlave):
                 acc_offset=(self.acc_offset_x, self.acc_offset_y, self.acc_offset_z),
                 latency=self.latency, mag_noise=self.mag_noise,
                 mag_offset=(self.mag_offset_x, self.mag_offset_y, self.mag_offset_z),
+                mag_soft_iron=tuple(tuple(getattr(self, f"mag_soft_iron_{row}_{c}") for c in "xyz") for row in "xyz"),
             )
             self.rng, self.mag_rng = NoiseStream(self.seed, SENSOR), NoiseStream(self.seed, MAGNETOMETER)
             self.delay, self.step_size = None, None

@@ -80,7 +80,7 @@ MODELS = {
     "NoOpEstimator": NativeModel(attitude_estimator, "AttitudeEstimator's interface; doStep does nothing "
                                  "(benchmark baseline)"),
     "ImuSensor": NativeModel(imu_sensor, "IMU sensor model: gyro noise density, offset, scale and misalignment, "
-                             "accelerometer noise and offset, magnetometer noise and hard iron; in C, no Python"),
+                             "accelerometer noise and offset, magnetometer noise, hard and soft iron; in C, no Python"),
     "MotionProfile": NativeModel(motion_profile, "Motion profiles with exact truth: ideal gyro, specific force, "
                                  "magnetic field, orientation; in C, no Python"),
 }

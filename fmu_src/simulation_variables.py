@@ -31,6 +31,9 @@ def imu_sensor() -> tuple[Variable, ...]:
     t.real("latency", 0.0, "s", "how long gyr and acc lag the motion (a fixed step needed)", PAR)
     t.real("mag_noise", 0.0, "uT/sqrt(Hz)", "magnetometer white-noise density, one-sided", PAR)
     t.vector("mag_offset", (0.0, 0.0, 0.0), "uT", "hard iron: a field {c} fixed to the sensor", PAR)
+    for row in "xyz":
+        t.vector(f"mag_soft_iron_{row}", (0.0, 0.0, 0.0), "1",
+                 f"soft iron: share of the true field's {{c}} in mag_{row}", PAR)
     t.parameter("seed", 1, "seed of the noise generator (systems.simulation.noise)", INTEGER)
     return tuple(t)
 

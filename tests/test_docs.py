@@ -43,3 +43,14 @@ def test_the_api_reference_documents_every_public_name():
     assert page.count(":::") == len(attitude_fmu.__all__)
     for name in attitude_fmu.__all__:
         assert f".{name}\n" in page + "\n"
+
+
+def test_the_scenarios_table_lists_every_scenario_with_its_description():
+    from attitude_fmu.systems.simulation.scenarios import SCENARIOS
+
+    page = hooks.scenarios_reference()
+    assert len(page.splitlines()) == 2 + len(SCENARIOS)
+    for name, s in SCENARIOS.items():
+        assert f"| `{name}` | {hooks._cell(s.description)} | `{s.profile}`" in page
+    guide = (ROOT / "docs" / "guide" / "recordings.md").read_text()
+    assert hooks.MARKER.format("scenarios") in guide

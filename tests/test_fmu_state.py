@@ -131,7 +131,7 @@ VALUE_CASES = [
     ("AttitudeEstimator", "method", 99),
     ("AttitudeEstimator", "heading", -1),
     ("AttitudeEstimator", "valid", 2),
-    ("MotionProfile coning", "profile", 9),
+    ("MotionProfile coning", "profile", 99),
 ]
 # (configuration, header field, offset, format, value): the header's own fields
 HEADER_CASES = [

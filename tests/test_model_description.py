@@ -283,7 +283,7 @@ def test_the_fmi3_estimator_answers_another_step_with_fmi3_ok(fmu_dir):
 
 @pytest.mark.parametrize("path, name, value", [
     ("native/AttitudeEstimator", "method", 7), ("native/AttitudeEstimator", "acc_samples", 0),
-    ("native/MotionProfile", "profile", 9), ("native/fmi3/AttitudeEstimator", "heading", 3),
+    ("native/MotionProfile", "profile", 99), ("native/fmi3/AttitudeEstimator", "heading", 3),
     ("native/fmi3/MotionProfile", "profile", -5), ("native/fmi3/AttitudeEstimator", "method", 2**40 + 1),
 ])
 def test_an_enumeration_value_none_of_its_items_has_is_refused_with_an_error(fmu_dir, path, name, value, capsys):

@@ -18,6 +18,7 @@ from attitude_fmu.systems.recordings.writing import CSV_DIGITS, write_recording
 from attitude_fmu.systems.simulation.motion import profile
 from attitude_fmu.systems.simulation.profile_table import EARTH_FIELD_UT
 from attitude_fmu.systems.simulation.recording import DEFAULT_MOTION, SENSORS, Sensor, simulate_recording
+from attitude_fmu.systems.simulation.scenarios import SCENARIOS
 
 IDEAL = Sensor(gyro_noise_dps=0.0, acc_noise=0.0, mag_noise=0.0)  # no noise, scale error, offset nor range
 GRAVITY = np.array([0.0, 0.0, STANDARD_GRAVITY])  # the simulation's specific force at rest, level, m/s²
@@ -171,6 +172,9 @@ def test_simulate_writes_the_recording_the_library_makes(tmp_path, capsys):
     (["--acc-range", "0"], "argument --acc-range: 0 is outside the plausible (0, 1e+09] g"),
     (["--motion", "unknown_name=1"], "unknown parameter 'unknown_name' for profile 'human'"),
     (["--out", "absent/r.csv", "--acc-range", "0.5"], "there is no folder"),
+    (["--scenario", "phone"], "attitude: error: unknown scenario 'phone'; available: phone_flat, phone_running, "
+                              "tactical_handheld, robot_arm, segment_40hz\n"),
+    (["--scenario", "robot_arm", "--motion", "rot_rms=1"], "unknown parameter 'rot_rms' for profile 'robot_arm'"),
 ])
 def test_bad_flags_are_refused_naming_them(tmp_path, monkeypatch, capsys, flags, message):
     """Exit status 2 and a message naming the flag, before any work: nothing written, and no
@@ -183,6 +187,28 @@ def test_bad_flags_are_refused_naming_them(tmp_path, monkeypatch, capsys, flags,
     err = capsys.readouterr().err
     assert status == 2 and message in err and "note:" not in err, err
     assert not any(tmp_path.iterdir())
+
+
+def test_simulate_writes_a_scenario_with_the_flags_given_overriding_it(tmp_path, capsys):
+    """--scenario phone_flat: the scenario's recording (its rate, rest, sensor and seed) of the
+    --duration asked; --fs, --seed and a sensor figure override the scenario's, --motion adds to its motion."""
+    out = tmp_path / "x.parquet"
+    assert main(["simulate", "--scenario", "phone_flat", "--out", str(out), "--duration", "5"]) == 0
+    rec = replace(SCENARIOS["phone_flat"], duration=5.0).recording(out.stem)
+    back = read_recording(out)
+    assert back.fs == pytest.approx(100.0, rel=1e-12) and len(back.t) == 100 * 15
+    for name in SIGNALS:
+        assert np.array_equal(getattr(back, name), getattr(rec, name)), name
+    assert f"attitude: wrote {out}: 1500 samples at 100 Hz (10 s at rest, then 5 s of motion), scenario phone_flat" \
+        in capsys.readouterr().err
+    assert main(["simulate", "--scenario", "phone_flat", "--out", str(tmp_path / "x.csv"), "--duration", "5",
+                 "--fs", "199", "--seed", "7", "--gyro-noise", "0.02", "--motion", "tilt_deg=10"]) == 0
+    s = SCENARIOS["phone_flat"]
+    rec = replace(s, duration=5.0, fs=199.0, seed=7, sensor=replace(s.sensor, gyro_noise_dps=0.02)).recording(
+        "x", motion={"tilt_deg": 10.0})
+    back = read_recording(tmp_path / "x.csv")
+    assert len(back.t) == len(rec.t) == 199 * 15
+    assert np.abs(back.gyr - rec.gyr).max() < 1e-9 and np.abs(back.quat_ref - rec.quat_ref).max() < 1e-9
 
 
 def test_evaluate_scores_a_simulated_recording(tmp_path, capsys):

@@ -7,13 +7,14 @@ Rizun's eqs. 1–2 with the streams SENSOR and MAGNETOMETER and a linear-interpo
 line; the noise densities measured over a long run are the parameters; refusals keep their
 words."""
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
 from scipy.signal import welch
 from scipy.spatial.transform import Rotation
 
-from attitude_fmu import HumanMotion, ImuModel, profile
+from attitude_fmu import HumanMotion, ImuModel, _core, profile
 from attitude_fmu.systems.simulation.motion import PROFILES
 from attitude_fmu.systems.simulation.noise import MAGNETOMETER, MOTION, SENSOR, normals
 from tests.motions import ClosedFormMotion, still
@@ -117,6 +118,49 @@ def _incline(incline_deg, peak_acc_g, frequency, g):
                                                              orient.apply([1.0, 0.0, 0.0]))
 
 
+def _yaw_pitch_roll(yaw, pitch, roll):
+    """Rz(yaw)·Ry(pitch)·Rx(roll), angles in rad (N each)."""
+    return Rotation.from_euler("ZYX", np.column_stack([yaw, pitch, roll]))
+
+
+def _running(p, g):
+    """Running: phase θ = 2π·f·t; vertical acceleration impact_g·g·Σ_{n=1..4} cos(nθ)/4, forward
+    forward_g·g·cos θ, sideways sway_g·g·cos(θ/2); pitch sin θ, roll and yaw sin(θ/2)."""
+    w = 2 * math.pi * p["step_frequency"]
+
+    def velocity(t):
+        up = sum(np.sin(n * w * t) / n for n in range(1, 5)) / (4 * w)
+        return g * np.column_stack([p["forward_g"] * np.sin(w * t) / w, 2 * p["sway_g"] * np.sin(w * t / 2) / w,
+                                    p["impact_g"] * up])
+    return (lambda t: _yaw_pitch_roll(*(math.radians(p[k]) * f(a * w * t) for k, f, a in (
+        ("yaw_deg", np.sin, 0.5), ("pitch_deg", np.sin, 1.0), ("roll_deg", np.sin, 0.5))))), velocity
+
+
+ROBOT_MOVES = ((2, 1.0), (0, 0.5), (1, -0.5), (1, 0.5), (0, -0.5), (2, -1.0))  # body axis, share of the angle
+
+
+def _robot_arm(p):
+    """The wrist turns about body axes by shares of angle_deg (ROBOT_MOVES, back to the start), each move
+    of minimum jerk s(τ) = 10τ³ − 15τ⁴ + 6τ⁵ over move s, then dwell s at rest; the sensor at the lever arm r
+    moves with v = R·(ω×r)."""
+    angle, period = math.radians(p["angle_deg"]), p["move"] + p["dwell"]
+    lever = np.array([p["lever_x"], p["lever_y"], p["lever_z"]])
+
+    def pose(t):
+        i = np.floor(t / period)
+        j = (i % len(ROBOT_MOVES)).astype(int)
+        tau = np.clip((t - i * period) / p["move"], 0.0, 1.0)
+        s, ds = tau**3 * (10 - 15 * tau + 6 * tau**2), 30 * tau**2 * (1 - tau) ** 2 / p["move"]
+        axes = np.eye(3)[[ROBOT_MOVES[k][0] for k in j]] * np.array([ROBOT_MOVES[k][1] for k in j])[:, None] * angle
+        before = [Rotation.identity()]
+        for axis, share in ROBOT_MOVES[:-1]:
+            before.append(before[-1] * Rotation.from_rotvec(np.eye(3)[axis] * share * angle))
+        start = Rotation.concatenate([before[k] for k in j])
+        return start * Rotation.from_rotvec(axes * s[:, None]), axes * ds[:, None]
+
+    return (lambda t: pose(t)[0]), lambda t: pose(t)[0].apply(np.cross(pose(t)[1], lever))
+
+
 # name → (parameters, g) → (orientation R(t), earth-frame velocity v(t)): the profiles' definitions
 CLOSED_FORMS = {
     "lever_arm": lambda p, g: (
@@ -138,6 +182,14 @@ CLOSED_FORMS = {
                            [1.0, 0.0, 0.0])),
     "offset_rotation": lambda p, g: _yaw_arm(p["frequency"], p["amplitude_deg"], p["radius"], p["inclination_deg"],
                                              p["pitch_deg"]),
+    "phone_flat": lambda p, g: (
+        lambda t: _yaw_pitch_roll(*(math.radians(p[k]) * f(a * 2 * math.pi * p["frequency"] * t) for k, f, a in (
+            ("yaw_deg", np.sin, 0.5), ("tilt_deg", np.sin, 0.7), ("tilt_deg", np.sin, 1.0)))),
+        lambda t: p["travel"] * 2 * math.pi * p["frequency"] * np.column_stack([
+            np.sin(2 * math.pi * p["frequency"] * t), 0.7 * np.sin(1.4 * math.pi * p["frequency"] * t),
+            np.zeros_like(t)])),
+    "running": _running,
+    "robot_arm": lambda p, g: _robot_arm(p),
 }
 
 
@@ -242,6 +294,102 @@ def test_the_human_motion_with_a_cell_per_sample_is_the_same_on_a_grid_of_the_sa
     assert np.abs(a.gyr - b.gyr).max() < 1e-10 and np.abs(a.acc - b.acc).max() < 1e-10 * np.abs(a.acc).max()
 
 
+# ---- a lever arm: the sensor at r from the motion's point feels ω×(ω×r) + α×r
+
+LEVER = np.array([0.3, -0.1, 0.2])  # m, body frame
+DELTA = 1e-6  # s: the finite differences' step
+
+
+def _lever_share(motion, earlier, later, span):
+    """The lever arm's share of the specific force of each sample of a motion that starts at rest (N×3,
+    body frame): the mean acceleration of the point R·LEVER over (t − h, t], (v(t) − v(t − h))/h, turned into
+    the body at t, its velocity v at each sample time the difference of the orientations earlier and later
+    (N×4 each) span s apart."""
+    v = (Rotation.from_quat(later, scalar_first=True).apply(LEVER)
+         - Rotation.from_quat(earlier, scalar_first=True).apply(LEVER)) / span
+    before = np.vstack([np.zeros((1, 3)), v[:-1]])
+    return Rotation.from_quat(motion.quat, scalar_first=True).inv().apply((v - before) * motion.fs)
+
+
+def test_a_lever_arm_on_the_human_motion_adds_its_points_acceleration():
+    """The human motion on a grid of 1 ms at 100 Hz, the sensor at LEVER: its specific force is the one
+    at the motion's point (the same seed, no lever) plus the mean acceleration of the point R·r, whose
+    velocity just before each sample time comes from the orientations DELTA apart (the rate is constant
+    within a cell and steps between cells, the steps' α×r included), within 1e-4 of its scale; the rate and
+    the orientation do not change. A cell per sample gives the same."""
+    motion = HumanMotion(0.4, 6.0, 2.5, 9.0, G, grid=1e-3, lever_x=LEVER[0], lever_y=LEVER[1], lever_z=LEVER[2])
+    moved, still_point = motion.generate(5.0, FS, seed=6), replace(motion, lever_x=0.0, lever_y=0.0,
+                                                                    lever_z=0.0).generate(5.0, FS, seed=6)
+    assert np.array_equal(moved.quat, still_point.quat) and np.array_equal(moved.gyr, still_point.gyr)
+    out = np.empty((2 * len(moved.t), _core.HUMAN_N_OUT))
+    motion.stream(6).run(np.column_stack([moved.t - DELTA, moved.t]).ravel(), out)
+    share = _lever_share(moved, out[0::2, 6:10], out[1::2, 6:10], DELTA)
+    assert np.abs(moved.acc - still_point.acc - share).max() < 1e-4 * np.abs(share).max()
+    per_sample = HumanMotion(0.4, 6.0, 2.5, 9.0, G, lever_x=LEVER[0], lever_y=LEVER[1], lever_z=LEVER[2])
+    a, b = per_sample.generate(5.0, FS, 2), replace(per_sample, grid=1.0 / FS).generate(5.0, FS, 2)
+    assert np.abs(a.acc - b.acc).max() < 1e-10 * np.abs(a.acc).max()
+
+
+def test_a_lever_arm_on_the_robot_arm_adds_its_points_acceleration():
+    """The robot arm (a smooth rate) with the sensor at LEVER: the specific force less the wrist's (no
+    lever) is the mean acceleration of the point R·r over each sample, its velocity by central differences
+    of the orientation, within 1e-5 of its scale; and it is ω×(ω×r) + α×r to first order in h."""
+    arm = profile("robot_arm")
+    moved = arm.motion(dict(zip(("lever_x", "lever_y", "lever_z"), LEVER)), g=G).generate(12.0, FS)
+    wrist_motion = arm.motion(g=G)
+    wrist = wrist_motion.generate(12.0, FS)
+    share = _lever_share(moved, *(wrist_motion.at(moved.t + d, 1.0 / FS)[2] for d in (-DELTA, DELTA)), 2 * DELTA)
+    assert np.abs(moved.acc - wrist.acc - share).max() < 1e-5 * np.abs(share).max()
+    w = moved.gyr  # the mean rate over each sample: ω(t − h/2) to second order
+    alpha = np.gradient(w, 1.0 / FS, axis=0)
+    first_order = np.cross(w, np.cross(w, LEVER)) + np.cross(alpha, LEVER)
+    assert np.abs(moved.acc - wrist.acc - first_order).max() < 0.05 * np.abs(first_order).max()
+
+
+# ---- the phone, running and robot-arm motions: what they stand for
+
+def _earth_acceleration(motion):
+    """The earth-frame acceleration (N×3, m/s²): the specific force turned by the orientation, less g up."""
+    return Rotation.from_quat(motion.quat, scalar_first=True).apply(motion.acc) - [0.0, 0.0, G]
+
+
+def test_the_phone_lies_mostly_flat_and_slides_a_little():
+    """phone_flat at its defaults: tilted at most tilt_deg·√2 (roll and pitch), yawing ±yaw_deg; its
+    acceleration at most travel·w²·√(1 + 0.7⁴)."""
+    motion = profile("phone_flat").motion(g=G).generate(60.0, FS)
+    tilt = np.degrees(np.arccos(np.clip(motion.up[:, 2], -1, 1)))
+    assert 2.5 < tilt.max() <= 3.0 * math.sqrt(2) + 1e-9
+    yaw = Rotation.from_quat(motion.quat, scalar_first=True).as_euler("ZYX", degrees=True)[:, 0]
+    assert 19.0 < np.abs(yaw).max() <= 20.0 + 1e-9
+    w = 2 * math.pi * 0.2
+    assert np.linalg.norm(_earth_acceleration(motion), axis=1).max() <= 0.05 * w**2 * math.sqrt(1 + 0.7**4) * 1.01
+
+
+def test_running_has_impacts_at_its_step_frequency_and_no_mean_acceleration():
+    """running at its defaults, 1 kHz: the vertical acceleration peaks at impact_g·g at every step (2.7 Hz:
+    its spectrum's strongest line), falls to −0.38·impact_g·g between (the specific force near 0: flight);
+    over whole strides (two steps) the acceleration averages to 0."""
+    fs = 1000.0
+    motion = profile("running").motion(g=G).generate(20.0 / 1.35, fs)  # 20 strides
+    a = _earth_acceleration(motion)
+    assert a[:, 2].max() == pytest.approx(2.5 * G, rel=1e-3)
+    assert a[:, 2].min() == pytest.approx(-0.37989 * 2.5 * G, rel=1e-3)
+    assert np.abs(a.mean(axis=0)).max() < 1e-3
+    spectrum = np.abs(np.fft.rfft(a[:, 2]))
+    assert np.fft.rfftfreq(len(a), 1.0 / fs)[np.argmax(spectrum)] == pytest.approx(2.7, abs=0.1)
+
+
+def test_the_robot_arm_turns_fast_with_little_linear_acceleration():
+    """robot_arm at its defaults with a 0.3 m lever arm: peak rate 1.875·angle/move (minimum jerk), and
+    the sensor's acceleration stays below a fifth of g (rms below a tenth); back to the start after its
+    six moves."""
+    motion = profile("robot_arm").motion({"lever_x": 0.3}, g=G).generate(6 * 1.7, FS)
+    assert np.linalg.norm(motion.gyr, axis=1).max() == pytest.approx(1.875 * math.pi / 2 / 1.2, rel=1e-3)
+    a = np.linalg.norm(_earth_acceleration(motion), axis=1)
+    assert a.max() < 0.2 * G and np.sqrt(np.mean(a**2)) < 0.1 * G
+    assert _same_rotations(motion.quat[-1:], np.array([[1.0, 0.0, 0.0, 0.0]])) < 1e-12
+
+
 @pytest.mark.parametrize("name", sorted(PROFILES))
 @pytest.mark.parametrize("edge", ["low", "high"])
 def test_every_profile_at_the_edges_of_its_ranges_gives_finite_samples_for_a_long_time(name, edge):
@@ -263,7 +411,8 @@ def test_every_profile_at_the_edges_of_its_ranges_gives_finite_samples_for_a_lon
 
 SENSOR_ERRORS = dict(delta_n=math.radians(0.1), gyr_offset=(0.01, -0.02, 0.03),
                      gyr_scale=((0.01, -0.002, 0.0), (0.003, 0.0, 0.005), (0.0, 0.004, -0.02)), acc_noise=0.01,
-                     acc_offset=(0.1, -0.2, 0.3), mag_noise=0.5, mag_offset=(8.0, -3.0, 12.0))
+                     acc_offset=(0.1, -0.2, 0.3), mag_noise=0.5, mag_offset=(8.0, -3.0, 12.0),
+                     mag_soft_iron=((0.05, 0.02, -0.01), (0.02, -0.06, 0.03), (-0.01, 0.03, 0.04)))
 
 
 def _late(x, samples):
@@ -281,7 +430,7 @@ def _late(x, samples):
 def test_the_sensor_measures_eqs_1_2_with_its_noise_streams_through_its_delay_line(latency):
     """gyr = (I + S)·ω + δ_n·√(fs/2)·z[0:3] + b, acc = f + σ_a·√(fs/2)·z[3:6] + b_a with z the
     stream SENSOR, ω and f latency late (between samples: linear between the two it falls
-    between); mag = m + σ_m·√(fs/2)·z_m + b_m with z_m the stream MAGNETOMETER (no delay)."""
+    between); mag = (I + S_m)·m + σ_m·√(fs/2)·z_m + b_m with z_m the stream MAGNETOMETER (no delay)."""
     imu = ImuModel(**SENSOR_ERRORS, latency=latency)
     motion = HumanMotion().generate(20.0, FS, seed=3)
     gyr, acc = imu.apply(motion, seed=4)
@@ -291,7 +440,9 @@ def test_the_sensor_measures_eqs_1_2_with_its_noise_streams_through_its_delay_li
     S = np.array(SENSOR_ERRORS["gyr_scale"])
     expected_gyr = omega + omega @ S.T + SENSOR_ERRORS["delta_n"] * scale * z[:, 0:3] + SENSOR_ERRORS["gyr_offset"]
     expected_acc = f + SENSOR_ERRORS["acc_noise"] * scale * z[:, 3:6] + SENSOR_ERRORS["acc_offset"]
-    expected_mag = motion.mag + SENSOR_ERRORS["mag_noise"] * scale * z_mag + SENSOR_ERRORS["mag_offset"]
+    soft = np.array(SENSOR_ERRORS["mag_soft_iron"])
+    expected_mag = (motion.mag + motion.mag @ soft.T + SENSOR_ERRORS["mag_noise"] * scale * z_mag
+                    + SENSOR_ERRORS["mag_offset"])
     assert np.abs(gyr - expected_gyr).max() < 1e-12 * np.abs(expected_gyr).max()
     assert np.abs(acc - expected_acc).max() < 1e-12 * np.abs(expected_acc).max()
     assert np.abs(mag - expected_mag).max() < 1e-12 * np.abs(expected_mag).max()
@@ -315,6 +466,9 @@ def test_a_sensor_a_whole_number_of_samples_late_shifts_the_motion_exactly():
     ({"gyr_scale": ((0.0, 0.0, 0.0), (0.0, 0.0, math.nan), (0.0, 0.0, 0.0))},
      "gyr_scale must be 3×3 finite numbers, got ((0.0, 0.0, 0.0), (0.0, 0.0, nan), (0.0, 0.0, 0.0))"),
     ({"gyr_scale": ((0.0, 0.0), (0.0, 0.0))}, "gyr_scale must be 3×3 finite numbers, got ((0.0, 0.0), (0.0, 0.0))"),
+    ({"mag_soft_iron": ((0.0, 0.0, 0.0), (math.inf, 0.0, 0.0), (0.0, 0.0, 0.0))},
+     "mag_soft_iron must be 3×3 finite numbers, got ((0.0, 0.0, 0.0), (inf, 0.0, 0.0), (0.0, 0.0, 0.0))"),
+    ({"mag_soft_iron": (0.1, 0.0, 0.0)}, "mag_soft_iron must be 3×3 finite numbers, got (0.1, 0.0, 0.0)"),
 ])
 def test_the_sensor_refuses_bad_parameters_in_its_words(values, message):
     with pytest.raises(ValueError) as refused:

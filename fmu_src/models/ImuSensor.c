@@ -33,7 +33,8 @@ static fmi2Status initialise(Fmi2Instance *instance) {
     const fmi2Real *r = instance->reals;
     ImuParams *p = &model->params;
     char message[MESSAGE_SIZE];
-    /* each vector's components are consecutive in the table: x, y, z; gyr_scale_<row>_<c> row by row */
+    /* each vector's components are consecutive in the table: x, y, z; gyr_scale_<row>_<c> and
+     * mag_soft_iron_<row>_<c> row by row */
     p->delta_n = r[REAL_delta_n];
     copy3(p->gyr_offset, &r[REAL_gyr_offset_x]);
     for (int i = 0; i < 9; i++) p->gyr_scale[i] = r[REAL_gyr_scale_x_x + i];
@@ -42,6 +43,7 @@ static fmi2Status initialise(Fmi2Instance *instance) {
     p->latency = r[REAL_latency];
     p->mag_noise = r[REAL_mag_noise];
     copy3(p->mag_offset, &r[REAL_mag_offset_x]);
+    for (int i = 0; i < 9; i++) p->mag_soft_iron[i] = r[REAL_mag_soft_iron_x_x + i];
     if (imu_check(p, message, sizeof message) != 0 ||
         check_seed(instance->integers[INTEGER_seed], &model->seed, message, sizeof message) != 0) {
         fmi2_log(instance, fmi2Error, "invalid parameter: %s", message);

@@ -77,7 +77,7 @@ static fmi2Status initialise(Fmi2Instance *instance) {
     }
     model->human = human;
     if (human) {
-        HumanParams params = {p[0], p[1], p[2], p[3], g};
+        HumanParams params = {p[0], p[1], p[2], p[3], g, {p[5], p[6], p[7]}}; /* p[4]: the grid */
         uint64_t seed;
         if (check_seed(instance->integers[INTEGER_seed], &seed, message, sizeof message) != 0) {
             fmi2_log(instance, fmi2Error, "invalid parameter: %s", message);

@@ -67,7 +67,10 @@ class HumanMotion:
     delta_v: slosh, density of the earth-frame velocity, m/s/√Hz (one-sided);
     omega_c: band limit of the velocity, rad/s; rot_rms: RMS angular rate per axis,
     rad/s; rot_cutoff: band limit of the angular rate, rad/s; g: gravity, m/s²;
-    grid: the time grid, s (None: the sample interval of generate()). Velocity and angular
+    grid: the time grid, s (None: the sample interval of generate()); lever_x, lever_y, lever_z:
+    the lever arm, the sensor's position from the motion's point in the body frame, m (its
+    specific force adds the mean of d/dt R·(ω×r) over each sample: ω×(ω×r) + α×r, the rate's
+    steps between cells included). Velocity and angular
     rate are first-order low-passed white noise, exact Ornstein–Uhlenbeck steps from one grid
     point to the next with a draw of the noise stream MOTION per cell (so velocity has the
     spectrum of eq. 14 at the grid points); within a cell the rate and the acceleration are
@@ -82,17 +85,25 @@ class HumanMotion:
     rot_cutoff: float = 5.0
     g: float = STANDARD_GRAVITY
     grid: float | None = None
+    lever_x: float = 0.0
+    lever_y: float = 0.0
+    lever_z: float = 0.0
 
     def __post_init__(self):
         grid = HUMAN_GRID if self.grid is None else self.grid
-        _core.profile_check("human", np.array([*self._params()[:4], grid], dtype=float), self.g)
+        _core.profile_check("human", np.array([*self._params()[:4], grid, *self.lever], dtype=float), self.g)
 
     def _params(self) -> tuple:
         return self.delta_v, self.omega_c, self.rot_rms, self.rot_cutoff, self.g
 
+    @property
+    def lever(self) -> np.ndarray:
+        """The lever arm r (3, m, body frame)."""
+        return np.array([self.lever_x, self.lever_y, self.lever_z], dtype=float)
+
     def coefficients(self, fs: float) -> np.ndarray:
-        """[phi_v, sig_v, phi_w, sig_w, Ts, g] of the exact OU steps of a grid cell of 1/fs s."""
-        return _core.human_coefficients(*self._params(), fs)
+        """[phi_v, sig_v, phi_w, sig_w, Ts, g, lever (3)] of the exact OU steps of a grid cell of 1/fs s."""
+        return _core.human_coefficients(*self._params(), self.lever, fs)
 
     def generate(self, duration: float, fs: float, seed: int = 0) -> Motion:
         """Sample duration (s) at fs (Hz) from a fixed seed (the noise stream MOTION of
@@ -133,18 +144,23 @@ class HumanMotion:
         """At rest, level: v = 0, ω = 0, q = identity."""
         return np.array([0, 0, 0, 0, 0, 0, 1.0, 0, 0, 0])
 
+    def start_quat(self) -> np.ndarray:
+        """The orientation at time 0 (4, sensor → earth): level."""
+        return self.initial_state()[6:10]
+
     def stream(self, seed: int = 0) -> _core.HumanStream:
         """The motion on its grid (None: profile_table.py's default) over any intervals from time 0
         (for the motion FMU): step(t, h) gives (gyr, specific force, quat) for the interval (t − h, t]
         as generate() samples it."""
-        return _core.HumanStream(*self._params()[:4], HUMAN_GRID if self.grid is None else self.grid, self.g, seed)
+        return _core.HumanStream(*self._params()[:4], HUMAN_GRID if self.grid is None else self.grid, self.lever,
+                                 self.g, seed)
 
 
 @dataclass(frozen=True)
 class ClosedForm:
     """A motion given by closed forms of orientation R(t) (sensor → earth) and earth-frame
     velocity v(t): the C core's profile name (lever_arm, incline, coning, sine_rotation,
-    step_rotation, linear_motion, offset_rotation; their formulas in
+    step_rotation, linear_motion, offset_rotation, phone_flat, running, robot_arm; their formulas in
     systems/simulation/core/closed_form.h) with its parameters in profile_table.py's order.
     Sampled over (t − h, t]: gyr is the rotation vector of R(t−h)ᵀR(t) over h (so
     integrating it reproduces R exactly) and the specific force is R(t)ᵀ·((v(t) − v(t−h))/h + g·ẑ)."""
@@ -162,6 +178,10 @@ class ClosedForm:
         gyr, acc, quat = np.empty((len(t), 3)), np.empty((len(t), 3)), np.empty((len(t), 4))
         _core.closed_form_run(self.name, np.array(self.params, dtype=float), self.g, t, h, gyr, acc, quat)
         return gyr, acc, quat
+
+    def start_quat(self) -> np.ndarray:
+        """The orientation at time 0 (4, sensor → earth): R(0)."""
+        return self.at(0.0, 1.0)[2][0]
 
     def generate(self, duration: float, fs: float, seed: int = 0) -> Motion:
         """Sample duration (s) at fs (Hz); seed is unused (the motion is deterministic)."""

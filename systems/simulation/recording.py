@@ -1,6 +1,6 @@
 """Recordings made by the simulator (`attitude simulate`): a rest, then human motion
-(systems.simulation.motion.HumanMotion), measured by a sensor of a datasheet's figures at any
-rate, with the motion's exact orientation as the reference, so that `attitude evaluate` scores
+(systems.simulation.motion.HumanMotion) or another motion profile, measured by a sensor of a
+datasheet's figures at any rate, with the motion's exact orientation as the reference, so that `attitude evaluate` scores
 them as it scores a lab's recordings. The sensors' table loads without python-control (the command
 line's help lists it); the simulation loads it when it runs."""
 from __future__ import annotations
@@ -17,7 +17,8 @@ if TYPE_CHECKING:
     from attitude_fmu.systems.simulation.sensor_model import ImuModel
 
 STANDARD_G = 9.80665  # m/s² in a g, as datasheets give accelerometer ranges
-SCALE_STREAM, OFFSET_STREAM = 2, 3  # the seed's streams of numpy's generator for the drawn errors
+# the seed's streams of numpy's generator for the drawn errors
+SCALE_STREAM, OFFSET_STREAM, SOFT_IRON_STREAM, HARD_IRON_STREAM = 2, 3, 4, 5
 MAX_SCALE_ERROR = 0.5  # rms scale and misalignment error: 50 % is no gyro's
 DEFAULT_MOTION = {"delta_v": 0.1, "grid": 0.02}  # a person moving about: 5 m/s² rms per axis at any rate
 
@@ -29,9 +30,13 @@ class Sensor:
     gyro_noise_dps: gyro white noise, °/s/√Hz; acc_noise: accelerometer white noise,
     m/s²/√Hz; gyro_scale_error: rms of each element of the gyro's scale-factor and
     misalignment matrix (1 = 100 %), the matrix drawn from the seed; gyro_offset_dps: the
-    norm of the gyro's constant offset, °/s, its direction drawn from the seed; gyro_range_dps
+    norm of the gyro's constant offset, °/s; gyro_offset_direction: its direction (3, any
+    length but 0; None: drawn from the seed); gyro_range_dps
     (°/s) and acc_range_g (g): the full scale of each axis, beyond which a sample reads the
-    full scale (inf: none); mag_noise: magnetometer white noise, µT/√Hz.
+    full scale (inf: none); mag_noise: magnetometer white noise, µT/√Hz; mag_soft_iron: rms
+    of each element of the magnetometer's symmetric soft-iron matrix S_m (1 = 100 %), drawn
+    from the seed; mag_hard_iron_ut: the norm of its hard iron, µT, its direction drawn from
+    the seed.
     """
 
     gyro_noise_dps: float = 0.02
@@ -41,29 +46,51 @@ class Sensor:
     gyro_range_dps: float = math.inf
     acc_range_g: float = math.inf
     mag_noise: float = 0.1
+    gyro_offset_direction: tuple | None = None
+    mag_soft_iron: float = 0.0
+    mag_hard_iron_ut: float = 0.0
 
     def __post_init__(self):
         for what, value, top in (("gyro noise", self.gyro_noise_dps, math.inf),
                                  ("accelerometer noise", self.acc_noise, math.inf),
                                  ("gyro scale error", self.gyro_scale_error, MAX_SCALE_ERROR),
                                  ("gyro offset", self.gyro_offset_dps, math.inf),
-                                 ("magnetometer noise", self.mag_noise, math.inf)):
+                                 ("magnetometer noise", self.mag_noise, math.inf),
+                                 ("magnetometer soft iron", self.mag_soft_iron, MAX_SCALE_ERROR),
+                                 ("magnetometer hard iron", self.mag_hard_iron_ut, math.inf)):
             if not (math.isfinite(value) and 0.0 <= value < top):
                 raise ValueError(f"{what} must be finite, non-negative"
                                  f"{'' if top == math.inf else f' and below {top:g}'}, got {value!r}")
         for what, value in (("gyro range", self.gyro_range_dps), ("accelerometer range", self.acc_range_g)):
             if not (value > 0.0):  # inf allowed: no range
                 raise ValueError(f"{what} must be a positive number (inf: none), got {value!r}")
+        if self.gyro_offset_direction is not None:
+            direction = np.asarray(self.gyro_offset_direction, dtype=float)
+            if direction.shape != (3,) or not np.isfinite(direction).all() or not direction.any():
+                raise ValueError(f"gyro offset direction must be 3 finite numbers, not all 0, "
+                                 f"got {self.gyro_offset_direction!r}")
 
     def model(self, seed: int = 0) -> ImuModel:
-        """The sensor model with its scale-factor matrix and offset direction drawn from seed."""
+        """The sensor model with its scale-factor matrix, soft iron and the directions not
+        given (gyro offset, hard iron) drawn from seed."""
         from attitude_fmu.systems.simulation.sensor_model import ImuModel
 
-        scale = np.random.default_rng((seed, SCALE_STREAM)).normal(0.0, self.gyro_scale_error, (3, 3))
-        direction = np.random.default_rng((seed, OFFSET_STREAM)).normal(size=3)
-        offset = math.radians(self.gyro_offset_dps) * direction / np.linalg.norm(direction)
+        def rng(stream):
+            return np.random.default_rng((seed, stream))
+
+        def along(norm, direction):
+            return tuple(norm * direction / np.linalg.norm(direction))
+
+        scale = rng(SCALE_STREAM).normal(0.0, self.gyro_scale_error, (3, 3))
+        direction = (rng(OFFSET_STREAM).normal(size=3) if self.gyro_offset_direction is None
+                     else np.asarray(self.gyro_offset_direction, dtype=float))
+        soft = np.triu(rng(SOFT_IRON_STREAM).normal(0.0, self.mag_soft_iron, (3, 3)))
         return ImuModel(delta_n=math.radians(self.gyro_noise_dps), acc_noise=self.acc_noise,
-                        gyr_scale=tuple(map(tuple, scale)), gyr_offset=tuple(offset), mag_noise=self.mag_noise)
+                        gyr_scale=tuple(map(tuple, scale)), gyr_offset=along(math.radians(self.gyro_offset_dps),
+                                                                             direction),
+                        mag_noise=self.mag_noise, mag_offset=along(self.mag_hard_iron_ut,
+                                                                   rng(HARD_IRON_STREAM).normal(size=3)),
+                        mag_soft_iron=tuple(map(tuple, soft + np.triu(soft, 1).T)))
 
 
 # sensors of three kinds, with figures typical of their datasheets
@@ -79,23 +106,26 @@ SENSORS = {
 
 def simulate_recording(fs: float, duration: float, rest: float = 10.0, sensor: Sensor = SENSORS["consumer"],
                        motion: dict | None = None, seed: int = 0, mag: bool = True,
-                       name: str = "simulated") -> Recording:
-    """A recording at fs (Hz): rest seconds still and level, then duration seconds of
-    human motion (the parameters of profile "human" updated by DEFAULT_MOTION, then by
-    motion), measured by sensor
+                       name: str = "simulated", motion_profile: str = "human") -> Recording:
+    """A recording at fs (Hz): rest seconds still in the pose the motion starts from (level
+    for the human motion), then duration seconds of the motion profile motion_profile (its
+    parameters updated by motion; the human motion's first by DEFAULT_MOTION), measured by sensor
     (its errors drawn from seed; the motion's noise from its stream of seed, the sensor's
     and the magnetometer's from theirs of seed + 1). The reference is the motion's orientation, the movement flag
     0 over the rest; with mag, the magnetometer sees the simulation's earth field. Samples
     beyond the sensor's range read its full scale; notes count them per sensor."""
+    from scipy.spatial.transform import Rotation
+
     from attitude_fmu.systems.simulation.motion import Motion, profile
 
-    human = profile("human").motion({**DEFAULT_MOTION, **(motion or {})})
+    defaults = DEFAULT_MOTION if motion_profile == "human" else {}
+    moves = profile(motion_profile).motion({**defaults, **(motion or {})})
     still = round(rest * fs)
-    moving = human.generate(duration, fs, seed)
-    g = human.g
-    truth = Motion(fs, np.vstack([np.tile([1.0, 0.0, 0.0, 0.0], (still, 1)), moving.quat]),
+    moving = moves.generate(duration, fs, seed)
+    start = Rotation.from_quat(moves.start_quat(), scalar_first=True)
+    truth = Motion(fs, np.vstack([np.tile(start.as_quat(scalar_first=True), (still, 1)), moving.quat]),
                    np.vstack([np.zeros((still, 3)), moving.gyr]),
-                   np.vstack([np.tile([0.0, 0.0, g], (still, 1)), moving.acc]))
+                   np.vstack([np.tile(start.inv().apply([0.0, 0.0, moves.g]), (still, 1)), moving.acc]))
     imu = sensor.model(seed)
     gyr, acc = imu.apply(truth, seed + 1)
     notes = []

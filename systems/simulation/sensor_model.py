@@ -22,7 +22,7 @@ def _rows(a, width: int) -> np.ndarray:
 @dataclass(frozen=True)
 class ImuModel:
     """Gyro y_g = (I + S)·ω + n + b, accelerometer y_a = f + n_a + acc_offset, magnetometer
-    y_m = m + n_m + mag_offset.
+    y_m = (I + S_m)·m + n_m + mag_offset.
 
     delta_n: gyro white-noise density, rad/s/√Hz (one-sided; per-sample s.d.
     delta_n·√(fs/2)); gyr_offset: constant gyro offset b, rad/s (3); gyr_scale: the gyro's
@@ -32,7 +32,8 @@ class ImuModel:
     offset, m/s² (3); latency: how long the measured gyro and accelerometer lag the motion,
     s (see delay_step; blocks.stages.timing compensates it); mag_noise: magnetometer white-noise
     density, µT/√Hz; mag_offset: hard iron, a field fixed to the sensor, µT (3; the
-    magnetometer has no latency). Noise enters as unit-normal samples, 6 per sample (gyro,
+    magnetometer has no latency); mag_soft_iron: soft iron S_m (3×3, row i: what axis i adds
+    of each true field component; 1 = 100 %). Noise enters as unit-normal samples, 6 per sample (gyro,
     acc), and 3 for the magnetometer (measure_mag).
     """
 
@@ -44,12 +45,14 @@ class ImuModel:
     latency: float = 0.0
     mag_noise: float = 0.0
     mag_offset: tuple = (0.0, 0.0, 0.0)
+    mag_soft_iron: tuple = ((0.0, 0.0, 0.0),) * 3
     vector: np.ndarray = field(init=False, repr=False, compare=False)  # the fields as the C core takes them
 
     def __post_init__(self):
         parts = []  # the C core checks the values (and words the refusal of a vector's shape)
         for name, shape in (("delta_n", ()), ("gyr_offset", (3,)), ("gyr_scale", (3, 3)), ("acc_noise", ()),
-                            ("acc_offset", (3,)), ("latency", ()), ("mag_noise", ()), ("mag_offset", (3,))):
+                            ("acc_offset", (3,)), ("latency", ()), ("mag_noise", ()), ("mag_offset", (3,)),
+                            ("mag_soft_iron", (3, 3))):
             value = np.asarray(getattr(self, name) if shape else float(getattr(self, name)), dtype=float)
             if value.shape != shape:
                 _core.imu_refuse_vector(name, getattr(self, name))

@@ -12,8 +12,16 @@
 #define STEP_LEVELS 10 /* STEP_SIZES_DEG, each followed by 0 */
 static const double STEP_SIZES_DEG[STEP_LEVELS / 2] = {5.0, 10.0, 20.0, 45.0, 90.0};
 
+/* ROBOT_ARM's moves: about the body axis (0 x, 1 y, 2 z) by a share of angle_deg; they compose to the identity */
+#define ROBOT_MOVES 6
+static const struct {
+    int axis;
+    double share;
+} ROBOT_MOVE[ROBOT_MOVES] = {{2, 1.0}, {0, 0.5}, {1, -0.5}, {1, 0.5}, {0, -0.5}, {2, -1.0}};
+
 const char *const CLOSED_FORM_NAMES[N_CLOSED_FORMS] = {
     "lever_arm", "incline", "coning", "sine_rotation", "step_rotation", "linear_motion", "offset_rotation",
+    "phone_flat", "running", "robot_arm",
 };
 
 static double radians(double degrees) { return degrees * (PI / 180.0); }
@@ -52,6 +60,46 @@ static double step_pitch(double hold, double ramp, double t) {
     return t < hold ? now * blend : before + (now - before) * blend;
 }
 
+/* Rotation.from_euler("ZYX", [yaw, pitch, roll]) (rad): about z, then the new y, then the new x */
+static Quat yaw_pitch_roll(double yaw, double pitch, double roll) {
+    return quat_multiply(quat_multiply(rot(2, yaw), rot(1, pitch)), rot(0, roll));
+}
+
+/* ROBOT_ARM at t: the move j under way (or the last one, resting after it), its share s done and ds/dt (1/s) */
+typedef struct {
+    int j;
+    double s, rate;
+} RobotMove;
+
+static RobotMove robot_move(const double *p, double t) {
+    double move = p[1], period = p[1] + p[2];
+    double i = floor(t / period), n = fmod(i, ROBOT_MOVES);
+    if (n < 0.0) n += ROBOT_MOVES;
+    double tau = fmin(fmax((t - i * period) / move, 0.0), 1.0);
+    RobotMove at = {isfinite(n) ? (int)n : 0, tau * tau * tau * (10.0 + tau * (-15.0 + 6.0 * tau)),
+                    30.0 * tau * tau * (1.0 - tau) * (1.0 - tau) / move};
+    if (!(n >= 0.0 && n < ROBOT_MOVES)) at.s = at.rate = NAN; /* t not finite */
+    return at;
+}
+
+static Quat robot_orientation(const double *p, double t) {
+    RobotMove at = robot_move(p, t);
+    Quat q = {1.0, 0.0, 0.0, 0.0};
+    for (int j = 0; j < at.j; j++) q = quat_multiply(q, rot(ROBOT_MOVE[j].axis, radians(p[0]) * ROBOT_MOVE[j].share));
+    return quat_multiply(q, rot(ROBOT_MOVE[at.j].axis, radians(p[0]) * ROBOT_MOVE[at.j].share * at.s));
+}
+
+/* the body rate (rad/s) at t of a profile with a lever arm */
+static Vec3 body_rate(const ClosedForm *m, double t) {
+    RobotMove at = robot_move(m->p, t);
+    double w = radians(m->p[0]) * ROBOT_MOVE[at.j].share * at.rate;
+    int axis = ROBOT_MOVE[at.j].axis;
+    return (Vec3){axis == 0 ? w : 0.0, axis == 1 ? w : 0.0, axis == 2 ? w : 0.0};
+}
+
+/* the lever arm (m, body frame) of a profile that takes one, else NULL */
+static const double *lever(const ClosedForm *m) { return m->profile == ROBOT_ARM ? m->p + 3 : NULL; }
+
 static Quat orientation(const ClosedForm *m, double t) {
     const double *p = m->p;
     switch (m->profile) {
@@ -64,6 +112,16 @@ static Quat orientation(const ClosedForm *m, double t) {
     case LINEAR_MOTION: return quat_normalized(intrinsic_xyz(p[2], p[3], p[4]));
     case OFFSET_ROTATION:
         return quat_multiply(rot(2, radians(p[1]) * sin(2 * PI * p[0] * t)), extrinsic_xy(p[3], p[4]));
+    case PHONE_FLAT: {
+        double w = 2 * PI * p[2];
+        return yaw_pitch_roll(radians(p[1]) * sin(0.5 * w * t), radians(p[0]) * sin(0.7 * w * t),
+                              radians(p[0]) * sin(w * t));
+    }
+    case RUNNING: {
+        double th = 2 * PI * p[0] * t;
+        return yaw_pitch_roll(radians(p[6]) * sin(th / 2), radians(p[4]) * sin(th), radians(p[5]) * sin(th / 2));
+    }
+    case ROBOT_ARM: return robot_orientation(p, t);
     default: return (Quat){NAN, NAN, NAN, NAN};
     }
 }
@@ -87,8 +145,32 @@ static Vec3 velocity(const ClosedForm *m, double t) {
         double psi = amp * sin(w * t), psi_dot = amp * w * cos(w * t);
         return (Vec3){p[2] * (-sin(psi) * psi_dot), p[2] * (cos(psi) * psi_dot), 0.0};
     }
+    case PHONE_FLAT: {
+        double w = 2 * PI * p[2];
+        return (Vec3){p[3] * w * sin(w * t), p[3] * 0.7 * w * sin(0.7 * w * t), 0.0};
+    }
+    case RUNNING: {
+        double w = 2 * PI * p[0], th = w * t, up = 0.0;
+        for (int n = 1; n <= 4; n++) up += sin(n * th) / n;
+        return (Vec3){p[2] * m->g * sin(th) / w, p[3] * m->g * 2.0 * sin(th / 2) / w, p[1] * m->g * up / (4 * w)};
+    }
     default: return (Vec3){0.0, 0.0, 0.0}; /* fixed in position */
     }
+}
+
+static Vec3 cross(Vec3 a, Vec3 b) { return (Vec3){a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+
+void lever_force(const double r[3], const double w0[3], const double w1[3], const double turn[4], double h,
+                 double f[3]) {
+    Vec3 arm = {r[0], r[1], r[2]}, rate = {w1[0], w1[1], w1[2]};
+    Vec3 now = cross(rate, arm);
+    if (!(h > 0.0)) {
+        Vec3 centripetal = cross(rate, now);
+        f[0] += centripetal.x, f[1] += centripetal.y, f[2] += centripetal.z;
+        return;
+    }
+    Vec3 before = quat_rotate(quat_conjugate(quat_load(turn)), cross((Vec3){w0[0], w0[1], w0[2]}, arm));
+    f[0] += (now.x - before.x) / h, f[1] += (now.y - before.y) / h, f[2] += (now.z - before.z) / h;
 }
 
 void rotation_vector(const double quat[4], double r[3]) {
@@ -117,6 +199,12 @@ void closed_form_at(const ClosedForm *m, double t, double h, double gyr[3], doub
     Vec3 sensor = quat_rotate(quat_conjugate(now), acc);
     f[0] = sensor.x, f[1] = sensor.y, f[2] = sensor.z;
     quat[0] = now.w, quat[1] = now.x, quat[2] = now.y, quat[3] = now.z;
+    const double *r = lever(m);
+    if (r) {
+        Vec3 a = body_rate(m, t - h), b = body_rate(m, t);
+        const double w0[3] = {a.x, a.y, a.z}, w1[3] = {b.x, b.y, b.z};
+        lever_force(r, w0, w1, turn, h, f);
+    }
 }
 
 void closed_form_run(const ClosedForm *m, const double *t, size_t n, double h, double *gyr, double *f, double *quat) {

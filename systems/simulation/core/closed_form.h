@@ -36,8 +36,22 @@ typedef enum {
      * mounted with inclination_deg about x and pitch_deg about y: R = Rz(psi) R_mount, position
      * radius (cos psi, sin psi, 0) */
     OFFSET_ROTATION,
+    /* a phone (mostly) flat on a table or a hand: R = Rz(yaw) Ry(pitch) Rx(roll) with roll tilt_deg
+     * sin(w t), pitch tilt_deg sin(0.7 w t), yaw yaw_deg sin(0.5 w t), w = 2 pi frequency (Hz); sliding
+     * about, position travel (m) (1 - cos(w t), 1 - cos(0.7 w t), 0) */
+    PHONE_FLAT,
+    /* running at step_frequency (Hz), phase th = 2 pi step_frequency t: vertical acceleration impact_g g
+     * (cos th + cos 2th + cos 3th + cos 4th)/4 (impacts of impact_g g, about -0.38 impact_g g between
+     * them), forward forward_g g cos th, sideways sway_g g cos(th/2) (a stride: two steps); R = Rz(yaw)
+     * Ry(pitch) Rx(roll), pitch pitch_deg sin th, roll roll_deg sin(th/2), yaw yaw_deg sin(th/2) */
+    RUNNING,
+    /* an industrial robot's wrist, fixed in position, turning through ROBOT_MOVES (closed_form.c) of
+     * angle_deg each, a move taking move (s) along a minimum-jerk law s(tau) = 10 tau^3 - 15 tau^4 + 6 tau^5,
+     * then dwell (s) at rest; the moves return to the start and repeat; R = W_j Rot(u_j, s angle_j). The
+     * sensor at the lever arm lever_x, lever_y, lever_z (m, body frame) from the wrist (lever_force) */
+    ROBOT_ARM,
     N_CLOSED_FORMS
-} ClosedFormProfile;
+} ClosedFormProfile; /* PHONE_FLAT, RUNNING and ROBOT_ARM start level, at rest (v(0) = 0) */
 
 /* the profiles' names, in the order above (profile_table.py's) */
 extern const char *const CLOSED_FORM_NAMES[N_CLOSED_FORMS];
@@ -49,6 +63,13 @@ typedef struct {
     double g;
 } ClosedForm;
 
+/* The lever arm's share of the specific force over an interval of h s added to f (sensor coordinates at its
+ * end, m/s^2): the mean acceleration of a point at r (body frame, m) from the motion's point,
+ * (R1 (w1 x r) - R0 (w0 x r))/h turned into the body at the end, with w0, w1 the body rates (rad/s) at the
+ * interval's start and end and turn = R0^T R1 the rotation over it: (w1 x r - turn^T (w0 x r))/h, whose limit
+ * is w x (w x r) + alpha x r; where h is 0 (not positive), the centripetal w1 x (w1 x r). */
+void lever_force(const double r[3], const double w0[3], const double w1[3], const double turn[4], double h,
+                 double f[3]);
 /* Rotation.as_rotvec: the rotation vector r (rad) of the unit quaternion quat, taken with w >= 0 */
 void rotation_vector(const double quat[4], double r[3]);
 /* the profile of that name: its number, or -1 */

@@ -20,6 +20,7 @@ void human_coefficients(const HumanParams *p, double fs, double coef[HUMAN_N_COE
     coef[3] = sqrt(p->rot_rms * p->rot_rms * (1 - phi_w * phi_w));
     coef[4] = Ts;
     coef[5] = p->g;
+    for (int i = 0; i < 3; i++) coef[6 + i] = p->lever[i];
 }
 
 void human_initial_state(double state[HUMAN_N_STATES]) {
@@ -35,12 +36,15 @@ void human_step(double state[HUMAN_N_STATES], const double noise[6], const doubl
     double v2 = phi_v * state[2] + sig_v * noise[2];
     Vec3 specific = {(v0 - state[0]) / Ts, (v1 - state[1]) / Ts, (v2 - state[2]) / Ts + g};
     state[0] = v0, state[1] = v1, state[2] = v2;
+    double w0[3] = {state[3], state[4], state[5]}, turn[4];
     for (int i = 3; i < 6; i++) state[i] = phi_w * state[i] + sig_w * noise[i];
     Quat dq = rotvec_quat(state[3] * Ts, state[4] * Ts, state[5] * Ts);
     Quat q = quat_normalized(quat_multiply((Quat){state[6], state[7], state[8], state[9]}, dq));
     Vec3 f = quat_rotate((Quat){q.w, -q.x, -q.y, -q.z}, specific);
     out[0] = state[3], out[1] = state[4], out[2] = state[5];
     out[3] = f.x, out[4] = f.y, out[5] = f.z;
+    quat_store(dq, turn);
+    lever_force(c + 6, w0, state + 3, turn, Ts, out + 3);
     out[6] = q.w, out[7] = q.x, out[8] = q.y, out[9] = q.z;
     state[6] = q.w, state[7] = q.x, state[8] = q.y, state[9] = q.z;
 }
@@ -85,9 +89,14 @@ int human_stream_step(HumanStream *s, double start, double end, double out[HUMAN
                       float_repr(end, a), HUMAN_MAX_CELLS, float_repr(G, b));
     start = fmax(start, s->t);
     Quat turn = {1.0, 0.0, 0.0, 0.0};
-    double dv[3] = {0.0, 0.0, 0.0}, t = start;
+    double dv[3] = {0.0, 0.0, 0.0}, t = start, w0[3] = {0.0, 0.0, 0.0};
+    int rate_at_start = 0;
     for (;;) { /* the pieces of the cells (start, end] crosses */
         double cell_end = (double)s->k * G;
+        if (!rate_at_start && start <= cell_end) { /* the rate of the cell (..., cell_end] start is in; 0 at time 0 */
+            for (int i = 0; i < 3; i++) w0[i] = s->state[3 + i];
+            rate_at_start = 1;
+        }
         if (s->k > 0 && t < cell_end) {
             double piece_end = fmin(end, cell_end), tau = piece_end - t;
             turn = quat_multiply(turn, rotvec_quat(s->state[3] * tau, s->state[4] * tau, s->state[5] * tau));
@@ -106,9 +115,9 @@ int human_stream_step(HumanStream *s, double start, double end, double out[HUMAN
         q = quat_normalized(quat_multiply(q, rotvec_quat(s->state[3] * tau, s->state[4] * tau, s->state[5] * tau)));
     }
     double w[3] = {s->state[3], s->state[4], s->state[5]}, acc[3] = {s->acc[0], s->acc[1], s->acc[2]};
+    double r[4];
+    quat_store(quat_normalized(turn), r);
     if (h > 0.0) {
-        double r[4];
-        quat_store(quat_normalized(turn), r);
         rotation_vector(r, w);
         for (int i = 0; i < 3; i++) w[i] /= h, acc[i] = dv[i] / h;
     }
@@ -116,6 +125,7 @@ int human_stream_step(HumanStream *s, double start, double end, double out[HUMAN
     out[0] = w[0], out[1] = w[1], out[2] = w[2];
     out[3] = f.x, out[4] = f.y, out[5] = f.z;
     quat_store(q, out + 6);
+    lever_force(s->params.lever, w0, h > 0.0 ? s->state + 3 : w, r, h, out + 3);
     s->t = end;
     return 0;
 }

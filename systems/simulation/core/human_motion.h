@@ -2,7 +2,9 @@
  * rotation on a time grid: velocity and angular rate are first-order low-passed white noise (exact
  * Ornstein-Uhlenbeck steps from one grid point to the next, a draw of 6 unit normals per grid cell);
  * within a cell the angular rate and the acceleration are constant (the velocity linear), so the
- * orientation and the velocity are exact at every time. Bound into Python by
+ * orientation and the velocity are exact at every time. A lever arm puts the sensor at r (body frame, m) from
+ * the motion's point: its specific force adds the mean over each interval of d/dt (R (omega x r)), exact for
+ * the rate constant within each cell and stepping between them (closed_form.h, lever_force). Bound into Python by
  * systems/simulation/motion.py (HumanMotion, HumanStream). */
 #ifndef SIM_HUMAN_MOTION_H
 #define SIM_HUMAN_MOTION_H
@@ -11,15 +13,16 @@
 #include <stdint.h>
 
 #define HUMAN_N_STATES 10 /* v (m/s, 3), omega (rad/s, 3), q (sensor -> earth, 4) */
-#define HUMAN_N_COEF 6    /* phi_v, sig_v, phi_w, sig_w, Ts (s), g (m/s^2) */
+#define HUMAN_N_COEF 9    /* phi_v, sig_v, phi_w, sig_w, Ts (s), g (m/s^2), lever (m, 3) */
 #define HUMAN_N_OUT 10    /* omega (rad/s, 3), specific force (m/s^2, 3), q (4) */
 #define HUMAN_MAX_CELLS 4194304.0 /* grid cells one step may draw (about 2 s of work; 70 min of the default grid) */
 
 /* delta_v: density of the velocity, m/s/sqrt(Hz); omega_c: its band limit, rad/s; rot_rms: RMS
- * angular rate per axis, rad/s; rot_cutoff: its band limit, rad/s; g: gravity, m/s^2 (their ranges:
- * profile_table.py's, checked by profile_params.h) */
+ * angular rate per axis, rad/s; rot_cutoff: its band limit, rad/s; g: gravity, m/s^2; lever: the sensor's
+ * position from the motion's point, body frame, m (their ranges: profile_table.py's, checked by
+ * profile_params.h) */
 typedef struct {
-    double delta_v, omega_c, rot_rms, rot_cutoff, g;
+    double delta_v, omega_c, rot_rms, rot_cutoff, g, lever[3];
 } HumanParams;
 
 /* the coefficients of the exact steps at sample rate fs (Hz): one grid cell of 1/fs s */

@@ -17,7 +17,7 @@ static const char *triple_repr(const double v[3], char out[TRIPLE_REPR_SIZE]) {
 }
 
 int imu_refuse_vector(const char *name, const char *repr, char *message, size_t size) {
-    const char *shape = strcmp(name, "gyr_scale") == 0 ? "3\u00d73" : "3";
+    const char *shape = strcmp(name, "gyr_scale") == 0 || strcmp(name, "mag_soft_iron") == 0 ? "3\u00d73" : "3";
     return refuse(message, size, "%s must be %s finite numbers, got %s", name, shape, repr);
 }
 
@@ -30,6 +30,7 @@ int imu_from_vector(const double v[IMU_VECTOR_SIZE], ImuParams *p, char *message
     p->latency = v[17];
     p->mag_noise = v[18];
     memcpy(p->mag_offset, v + 19, sizeof p->mag_offset);
+    memcpy(p->mag_soft_iron, v + 22, sizeof p->mag_soft_iron);
     return imu_check(p, message, size);
 }
 
@@ -47,21 +48,28 @@ int imu_check(const ImuParams *p, char *message, size_t size) {
     for (int i = 0; i < 3; i++)
         if (!(isfinite(components[i][0]) && isfinite(components[i][1]) && isfinite(components[i][2])))
             return imu_refuse_vector(vectors[i], triple_repr(components[i], tuple[0]), message, size);
-    for (int c = 0; c < 9; c++)
-        if (!isfinite(p->gyr_scale[c])) {
-            snprintf(matrix, sizeof matrix, "(%s, %s, %s)", triple_repr(p->gyr_scale, tuple[0]),
-                     triple_repr(p->gyr_scale + 3, tuple[1]), triple_repr(p->gyr_scale + 6, tuple[2]));
-            return imu_refuse_vector("gyr_scale", matrix, message, size);
-        }
+    const char *matrices[2] = {"gyr_scale", "mag_soft_iron"};
+    const double *elements[2] = {p->gyr_scale, p->mag_soft_iron};
+    for (int i = 0; i < 2; i++)
+        for (int c = 0; c < 9; c++)
+            if (!isfinite(elements[i][c])) {
+                snprintf(matrix, sizeof matrix, "(%s, %s, %s)", triple_repr(elements[i], tuple[0]),
+                         triple_repr(elements[i] + 3, tuple[1]), triple_repr(elements[i] + 6, tuple[2]));
+                return imu_refuse_vector(matrices[i], matrix, message, size);
+            }
     return 0;
+}
+
+/* row i of the matrix M (row-major) times v */
+static double row_times(const double *M, int i, const double v[3]) {
+    return M[3 * i] * v[0] + M[3 * i + 1] * v[1] + M[3 * i + 2] * v[2];
 }
 
 void imu_measure(const ImuParams *p, const double omega[3], const double f[3], const double noise[6], double fs,
                  double gyr[3], double acc[3]) {
     double scale = sqrt(fs / 2.0);
-    const double *S = p->gyr_scale;
     for (int i = 0; i < 3; i++) {
-        double added = omega[0] * S[3 * i] + omega[1] * S[3 * i + 1] + omega[2] * S[3 * i + 2]; /* omega @ S.T */
+        double added = row_times(p->gyr_scale, i, omega); /* omega @ S.T */
         gyr[i] = omega[i] + added + p->delta_n * scale * noise[i] + p->gyr_offset[i];
         acc[i] = f[i] + p->acc_noise * scale * noise[3 + i] + p->acc_offset[i];
     }
@@ -69,7 +77,7 @@ void imu_measure(const ImuParams *p, const double omega[3], const double f[3], c
 
 void imu_measure_mag(const ImuParams *p, const double m[3], const double noise[3], double fs, double mag[3]) {
     double scale = p->mag_noise * sqrt(fs / 2.0);
-    for (int i = 0; i < 3; i++) mag[i] = m[i] + scale * noise[i] + p->mag_offset[i];
+    for (int i = 0; i < 3; i++) mag[i] = m[i] + row_times(p->mag_soft_iron, i, m) + scale * noise[i] + p->mag_offset[i];
 }
 
 void imu_measure_run(const ImuParams *p, const double *omega, const double *f, const double *noise, size_t n,

@@ -81,12 +81,14 @@ void check_profile(const std::string &name, const double *values, size_t n, doub
     raise_if(profile_check(profile, values, n, g, message, sizeof message), message);
 }
 
-// the human motion's parameters and its grid (s), checked
-HumanParams human_params(double delta_v, double omega_c, double rot_rms, double rot_cutoff, double grid, double g)
+// the human motion's parameters, its grid (s) and its lever arm (m), checked
+HumanParams human_params(double delta_v, double omega_c, double rot_rms, double rot_cutoff, double grid, double g,
+                         In<3> lever)
 {
-    const double values[5] = {delta_v, omega_c, rot_rms, rot_cutoff, grid};
-    check_profile("human", values, 5, g);
-    return HumanParams{delta_v, omega_c, rot_rms, rot_cutoff, g};
+    const double *r = lever.data();
+    const double values[8] = {delta_v, omega_c, rot_rms, rot_cutoff, grid, r[0], r[1], r[2]};
+    check_profile("human", values, 8, g);
+    return HumanParams{delta_v, omega_c, rot_rms, rot_cutoff, g, {r[0], r[1], r[2]}};
 }
 
 // the stream's (start, end] as (gyr, specific force, quat), else ValueError
@@ -167,14 +169,16 @@ void bind_human_motion(nb::module_ &m)
         "ranges (profile_table.py's): ValueError naming the parameter, its value and the range.");
     m.def(
         "human_coefficients",
-        [](double delta_v, double omega_c, double rot_rms, double rot_cutoff, double g, double fs) {
-            HumanParams p = {delta_v, omega_c, rot_rms, rot_cutoff, g};
+        [](double delta_v, double omega_c, double rot_rms, double rot_cutoff, double g, In<3> lever, double fs) {
+            const double *r = lever.data();
+            HumanParams p = {delta_v, omega_c, rot_rms, rot_cutoff, g, {r[0], r[1], r[2]}};
             Vector coef = new_vector(HUMAN_N_COEF);
             human_coefficients(&p, fs, coef.data());
             return coef;
         },
         nb::arg("delta_v"), nb::arg("omega_c"), nb::arg("rot_rms"), nb::arg("rot_cutoff"), nb::arg("g"),
-        nb::arg("fs"), "[phi_v, sig_v, phi_w, sig_w, Ts, g]: the exact steps' coefficients at fs (Hz).");
+        nb::arg("lever"), nb::arg("fs"),
+        "[phi_v, sig_v, phi_w, sig_w, Ts, g, lever (3)]: the exact steps' coefficients at fs (Hz).");
     m.def(
         "human_run",
         [](Out<HUMAN_N_STATES> state, In<-1, 6> noise, In<HUMAN_N_COEF> coef, Out<-1, HUMAN_N_OUT> out) {
@@ -190,14 +194,14 @@ void bind_human_motion(nb::module_ &m)
         .def(
             "__init__",
             [](HumanStream *s, double delta_v, double omega_c, double rot_rms, double rot_cutoff, double grid,
-               double g, nb::handle seed) {
-                HumanParams p = human_params(delta_v, omega_c, rot_rms, rot_cutoff, grid, g);
+               In<3> lever, double g, nb::handle seed) {
+                HumanParams p = human_params(delta_v, omega_c, rot_rms, rot_cutoff, grid, g, lever);
                 uint64_t value = seed_value(seed);
                 new (s) HumanStream;
                 human_stream_init(s, &p, grid, value);
             },
             nb::arg("delta_v"), nb::arg("omega_c"), nb::arg("rot_rms"), nb::arg("rot_cutoff"), nb::arg("grid"),
-            nb::arg("g"), nb::arg("seed"))
+            nb::arg("lever"), nb::arg("g"), nb::arg("seed"))
         .def(
             "step", [](HumanStream &s, double t, double h) { return stream_step(s, t - h, t); }, nb::arg("t"),
             nb::arg("h"), "Ideal (gyr, specific force, quat) for the interval (t - h, t] (s).")
@@ -225,7 +229,9 @@ void bind_human_motion(nb::module_ &m)
             HumanStream restored;
             std::memcpy(&restored, state.c_str(), sizeof restored);
             const HumanParams &p = restored.params;
-            human_params(p.delta_v, p.omega_c, p.rot_rms, p.rot_cutoff, restored.grid, p.g);
+            const double values[8] = {p.delta_v, p.omega_c, p.rot_rms, p.rot_cutoff, restored.grid,
+                                      p.lever[0], p.lever[1], p.lever[2]};
+            check_profile("human", values, 8, p.g);
             new (&s) HumanStream(restored);
         });
 }
@@ -286,7 +292,7 @@ void bind_sensor(nb::module_ &m)
             throw nb::value_error(message);
         },
         nb::arg("name"), nb::arg("value"),
-        "ValueError: the vector parameter name (gyr_offset, acc_offset, mag_offset, gyr_scale) is not "
+        "ValueError: the vector parameter name (gyr_offset, acc_offset, mag_offset, gyr_scale, mag_soft_iron) is not "
         "finite numbers of its shape, given value.");
     m.def(
         "imu_measure",
