@@ -3,7 +3,8 @@
     python docs/figures.py [--broad DIR] [--only NAME ...]
 
 runs `attitude table1 --json`, `attitude evaluate --json` (online and --offline) on the BROAD
-recordings and on recordings `attitude simulate` makes, `attitude compare --json`, `attitude verify --json`, `attitude bench --json` (also
+recordings and on recordings `attitude simulate` makes, the scenario suite (systems.evaluation.scenarios),
+`attitude compare --json`, `attitude verify --json`, `attitude bench --json` (also
 `--fmu`, `--io` and `--workers 2`),
 `attitude bode` and `attitude plot`, writes what each printed to docs/generated/NAME.json, and
 from those files the Markdown tables (NAME.md, included by the pages) and the figures
@@ -214,6 +215,25 @@ def simulated(refresh: bool) -> None:
     write_md("simulated_motion", _simulated_table(load("simulated_motion")))
 
 
+def scenarios(refresh: bool) -> None:
+    """The scenario suite (systems.evaluation.scenarios): ours against vqf in each column, online and
+    offline, 6D and 9D (scenarios.json, {scenario: {column: {"ours", "vqf"}}}); a cell where vqf is
+    ahead is marked."""
+    if refresh:
+        from attitude_fmu.systems.evaluation.scenarios import score_all
+
+        (OUT / "scenarios.json").write_text(json.dumps(score_all(), indent=1) + "\n")
+    data = load("scenarios")
+    columns = list(next(iter(data.values())))
+    lines = ["| scenario | " + " | ".join(columns) + " |", "|---|" + "---:|" * len(columns)]
+    for name, row in data.items():
+        cells = [f"{row[c]['ours']:.2f} / {row[c]['vqf']:.2f}" + (" ✗" if row[c]["ours"] > row[c]["vqf"] else "")
+                 for c in columns]
+        lines.append(f"| {name} | " + " | ".join(cells) + " |")
+    write_md("scenarios", lines + ["", "RMS error in degrees, ours / vqf's (offline columns: vqf's offline "
+                                   "estimate); ✗: vqf ahead."])
+
+
 def compare(refresh: bool) -> None:
     data = run_json("compare", "compare") if refresh else load("compare")
     methods = list(next(iter(data["profiles"].values())))
@@ -288,7 +308,8 @@ def bode(refresh: bool) -> None:
             attitude("bode", "--method", method, "--out", str(OUT / f"bode_{method}.png"))
 
 
-FIGURES = {"table1": table1, "spectrum": spectrum, "broad": broad, "simulated": simulated, "compare": compare,
+FIGURES = {"table1": table1, "spectrum": spectrum, "broad": broad, "simulated": simulated, "scenarios": scenarios,
+           "compare": compare,
            "verify": verify,
            "bench": bench, "bench_fmu": bench_fmu, "bench_io": bench_io,
            "bench_workers": bench_workers, "bode": bode}
