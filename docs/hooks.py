@@ -88,7 +88,8 @@ def scenarios_reference() -> str:
     """A table of the simulator's scenarios: name, description, motion, rate and durations, seed, sensor."""
     from attitude_fmu.systems.simulation.scenarios import SCENARIOS
 
-    out = ["| scenario | what it stands for | motion | rate | rest, motion | seed | sensor |", "|---|---|---|---|---|---|---|"]
+    out = ["| scenario | what it stands for | motion | rate | rest, motion | seed | sensor |",
+           "|---|---|---|---|---|---|---|"]
     for name, s in SCENARIOS.items():
         motion = f"`{s.profile}`" + "".join(f", {k}={v:g}" for k, v in s.motion.items())
         f = s.sensor

@@ -346,6 +346,58 @@ def test_a_lever_arm_on_the_robot_arm_adds_its_points_acceleration():
     assert np.abs(moved.acc - wrist.acc - first_order).max() < 0.05 * np.abs(first_order).max()
 
 
+# ---- the phone, running and robot-arm motions: their rates are their orientations' derivatives
+
+def _euler_rate(angles, rates):
+    """The body rate (N×3, rad/s) of Rz(ψ)·Ry(θ)·Rx(φ) from the angles (ψ, θ, φ) and their time derivatives
+    (each N): Rx(φ)ᵀ·Ry(θ)ᵀ·ψ̇ẑ + Rx(φ)ᵀ·θ̇ŷ + φ̇x̂."""
+    (psi, theta, phi), (psi_dot, theta_dot, phi_dot) = angles, rates
+    roll, pitch = Rotation.from_euler("x", phi[:, None]), Rotation.from_euler("y", theta[:, None])
+    z, y = np.column_stack([0 * psi, 0 * psi, psi_dot]), np.column_stack([0 * psi, theta_dot, 0 * psi])
+    return roll.inv().apply(pitch.inv().apply(z)) + roll.inv().apply(y) + np.column_stack([phi_dot, 0 * psi, 0 * psi])
+
+
+def _analytic_rate(name, p, t):
+    """The body rate (N×3, rad/s) at the times t, by differentiating each profile's angles by hand."""
+    if name == "phone_flat":
+        w, a, b = 2 * math.pi * p["frequency"], math.radians(p["yaw_deg"]), math.radians(p["tilt_deg"])
+        parts = ((a, 0.5 * w), (b, 0.7 * w), (b, w))
+    else:
+        w = 2 * math.pi * p["step_frequency"]
+        parts = ((math.radians(p["yaw_deg"]), 0.5 * w), (math.radians(p["pitch_deg"]), w),
+                 (math.radians(p["roll_deg"]), 0.5 * w))
+    return _euler_rate([k * np.sin(c * t) for k, c in parts], [k * c * np.cos(c * t) for k, c in parts])
+
+
+@pytest.mark.parametrize("name", ["phone_flat", "running"])
+def test_the_phone_and_running_rates_are_their_euler_angles_derivatives(name):
+    """Over samples of 1e-4 s, gyr (the mean rate over each) is the body rate of the hand-differentiated
+    Euler angles at the sample's middle, within 1e-6 of its scale (the midpoint rule's error, h²·ω̈/24)."""
+    p = {q.name: q.default for q in PROFILES[name].params}
+    h = 1e-4
+    t = np.arange(1, 20001) * h
+    gyr = profile(name).motion(g=G).at(t, h)[0]
+    expected = _analytic_rate(name, p, t - h / 2)
+    assert np.abs(gyr - expected).max() < 1e-6 * np.abs(expected).max()
+
+
+def test_the_robot_arms_rate_is_its_minimum_jerk_law():
+    """Over samples of 1e-4 s, gyr is the move's axis times angle·ds/dt at the sample's middle, ds/dt =
+    30τ²(1 − τ)²/move, within 1e-6 of its peak 1.875·angle/move; 0 while it dwells."""
+    p = {q.name: q.default for q in PROFILES["robot_arm"].params}
+    h, angle = 1e-4, math.radians(p["angle_deg"])
+    t = np.arange(1, 6 * 17001) * h
+    gyr = profile("robot_arm").motion(g=G).at(t, h)[0]
+    period, mid = p["move"] + p["dwell"], t - h / 2
+    i = np.floor(mid / period)
+    tau = np.clip((mid - i * period) / p["move"], 0.0, 1.0)
+    axes = np.array([np.eye(3)[ROBOT_MOVES[int(k) % 6][0]] * ROBOT_MOVES[int(k) % 6][1] for k in i])
+    expected = axes * (angle * 30 * tau**2 * (1 - tau) ** 2 / p["move"])[:, None]
+    peak = 1.875 * angle / p["move"]
+    assert np.abs(gyr - expected).max() < 1e-6 * peak
+    assert np.abs(expected).max() == pytest.approx(peak, rel=1e-6)
+
+
 # ---- the phone, running and robot-arm motions: what they stand for
 
 def _earth_acceleration(motion):

@@ -1,8 +1,8 @@
 """Recordings made by the simulator (`attitude simulate`): a rest, then human motion
 (systems.simulation.motion.HumanMotion) or another motion profile, measured by a sensor of a
-datasheet's figures at any rate, with the motion's exact orientation as the reference, so that `attitude evaluate` scores
-them as it scores a lab's recordings. The sensors' table loads without python-control (the command
-line's help lists it); the simulation loads it when it runs."""
+datasheet's figures at any rate, with the motion's exact orientation as the reference, so that
+`attitude evaluate` scores them as it scores a lab's recordings. The sensors' table loads without
+python-control (the command line's help lists it); the simulation loads it when it runs."""
 from __future__ import annotations
 
 import math
