@@ -13,14 +13,12 @@ static const double PI = 3.14159265358979323846;
 int heading_coefficients(const double params[AF_N_PARAMS], double Ts, AfHeadingCoef *coef)
 {
     double q = 0.5 * params[AF_P_delta_n] * params[AF_P_delta_n];
-    coef->Ts = Ts;
     coef->q_psi = q;
     coef->r_drift = params[AF_P_tau_heading] * params[AF_P_tau_heading] * q;
     coef->q_rate = params[AF_P_sigma_motion] * params[AF_P_sigma_motion] / params[AF_P_tau_reference];
     coef->block_steps = fmax(1.0, round(DRIFT_BLOCK_TAUS * params[AF_P_tau_heading] / Ts));
     coef->a_block = coef->block_steps * Ts / params[AF_P_tau_reference];
     coef->rate_max = params[AF_P_heading_drift];
-    coef->P_rate = coef->rate_max * coef->rate_max;
     coef->rate_left = params[AF_P_sigma_motion];
     coef->rate_heading = Ts / params[AF_P_tau_heading];
     coef->rate_reference = Ts / params[AF_P_tau_reference];
@@ -64,7 +62,7 @@ static void restart(AfHeading *state, const AfHeadingCoef *coef, int afresh)
     state->blocks = 0.0, state->blk_n = 0.0, state->blk_sum = 0.0, state->blk_steps = 0.0, state->unwrapped = 0.0;
     if (afresh) {
         state->rate = 0.0;
-        state->var_rate = coef->P_rate;
+        state->var_rate = coef->rate_max * coef->rate_max;
         state->d2[1] = 0.0;
         state->follow = 0.0;
     }
@@ -106,13 +104,13 @@ static double density(double d2, double t)
 static void drift_block(AfHeading *state, const AfHeadingCoef *coef, double mean, double steps, int start)
 {
     double *prev = state->blk_mean, P[3] = {state->var_level, state->covariance, state->var_rate};
-    double dt = 0.5 * (steps + state->blk_last) * coef->Ts; /* from the last block's middle to this one's */
+    double dt = 0.5 * (steps + state->blk_last) * coef->mag_delay.Ts; /* from the last block's middle to this one's */
     state->blk_last = steps;
     if (state->blocks >= 2.0)
         second_difference(state->d2, fabs(remainder(mean - 2.0 * prev[1] + prev[0], 2.0 * PI)), coef->a_block);
     if (state->blocks >= 2.0 && !start) {
-        double s = fmax(coef->r_drift, density(state->d2[0], coef->block_steps * coef->Ts));
-        double r = s / (steps * coef->Ts);
+        double s = fmax(coef->r_drift, density(state->d2[0], coef->block_steps * coef->mag_delay.Ts));
+        double r = s / (steps * coef->mag_delay.Ts);
         state->level += state->rate * dt;
         P[0] += dt * (2.0 * P[1] + dt * P[2]) + coef->q_psi * dt;
         P[1] += dt * P[2];
@@ -128,7 +126,7 @@ static void drift_block(AfHeading *state, const AfHeadingCoef *coef, double mean
             state->rate = state->rate > 0.0 ? coef->rate_max : -coef->rate_max;
     } else { /* the level from this block (within the start-up, or of the first two blocks) */
         state->level = mean;
-        P[0] = coef->r_drift / (steps * coef->Ts), P[1] = 0.0;
+        P[0] = coef->r_drift / (steps * coef->mag_delay.Ts), P[1] = 0.0;
     }
     state->var_level = P[0], state->covariance = P[1], state->var_rate = P[2];
     state->follow = followed(state->rate, P[2], coef);
@@ -263,9 +261,10 @@ static int field_sample(AfHeading *state, const AfHeadingCoef *coef, Quat q, Vec
             restart(state, coef, 0);
         }
     }
+    if (!ok && !start)
+        return 0;
     double h = atan2(m.x, m.y); /* the field's heading: psi - h the heading error (psi within [-pi, pi]) */
-    if (ok || start)
-        field_noise(state, coef, h, gap, start);
+    field_noise(state, coef, h, gap, start);
     if (start) { /* running means, every sample */
         ok = 1;
         state->psi_c += wrapped(h - state->psi_c) / state->seen;

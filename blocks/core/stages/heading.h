@@ -13,17 +13,17 @@
 
 /* The stage's own state: psi_c, the heading correction (rad); the drift estimate: its level (rad, the unwrapped
  * field heading at the last block's middle), drift rate (rad/s), the level's variance, its covariance with the
- * rate and the rate's variance; the rate psi_c follows (rad/s); the last field heading, the field heading unwrapped since the start; the block's
- * sum of it, its samples and steps; the last block's steps; the blocks since the start; the last two block means
- * (the older first); the noise measure (mean |second difference|, rad) and the blocks in it; the field in the
- * earth frame before the turn by psi_c, through the guard's low-pass; the reference norm (the field's unit) and
- * dip (rad); the field samples since the start-up began; the candidate field's norm, dip, field samples and
- * smallest |q.q0| since it began, q0 the orientation then; the steps since the start-up began; the step the
- * candidate began at; the steps since the last field sample; the last step's orientation (0: none yet). The
- * magnetometer's noise, measured over its distinct samples (a held sample repeats the last): the last sample as
- * given; the last two distinct ones in the earth frame, the newest first; how many there were; the sums of the
- * absolute second differences of those, per axis; the steps spanned from the first to the newest; the steps since
- * the newest. The hard-iron fit's and the delay's states follow. */
+ * rate and the rate's variance; the rate psi_c follows (rad/s); the last field heading, the field heading
+ * unwrapped since the start; the block's sum of it, its samples and steps; the last block's steps; the blocks
+ * since the start; the last two block means (the older first); the noise measure (mean |second difference|, rad)
+ * and the blocks in it; the field in the earth frame before the turn by psi_c, through the guard's low-pass; the
+ * reference norm (the field's unit) and dip (rad); the field samples since the start-up began; the candidate
+ * field's norm, dip, field samples and smallest |q.q0| since it began, q0 the orientation then; the steps since
+ * the start-up began; the step the candidate began at; the steps since the last field sample; the last step's
+ * orientation (0: none yet). The magnetometer's noise, measured over its distinct samples (a held sample repeats
+ * the last): the last sample as given; the last two distinct ones in the earth frame, the newest first; how many
+ * there were; the sums of the absolute second differences of those, per axis; the steps spanned from the first to
+ * the newest; the steps since the newest. The hard-iron fit's and the delay's states follow. */
 #define HEADING_FIELDS(X)                                                                                          \
     X(psi_c, ) X(level, ) X(rate, ) X(var_level, ) X(covariance, ) X(var_rate, ) X(follow, ) X(h_last, )          \
     X(unwrapped, ) X(blk_sum, ) X(blk_n, ) X(blk_steps, ) X(blk_last, ) X(blocks, ) X(blk_mean, [2]) X(d2, [2])    \
@@ -40,14 +40,12 @@ extern const size_t HEADING_N_FIELDS;
 
 /* Its coefficients at one step (IMU sample) time Ts. */
 typedef struct {
-    double Ts;                                       /* s */
     double q_psi;                                    /* delta_n^2/2: the heading's random walk (rad^2/s) */
     double q_rate;                                   /* sigma_motion^2/tau_reference: the drift rate's ((rad/s)^2/s) */
     double r_drift;                                  /* the field heading's noise density for the drift (rad^2 s) */
-    double rate_max;                                 /* heading_drift: the largest drift rate (rad/s) */
-    double P_rate;                                   /* heading_drift^2: the drift rate's prior variance ((rad/s)^2) */
-    double block_steps;                              /* the field noise measure's block: DRIFT_BLOCK_TAUS tau_heading (steps) */
-    double a_block;                                  /* a block's weight in that measure at the longest (block/tau_reference) */
+    double rate_max;                                 /* heading_drift: the largest drift rate, its prior s.d. (rad/s) */
+    double block_steps;                              /* the noise measure's block: DRIFT_BLOCK_TAUS tau_heading */
+    double a_block;                                  /* a block's least weight in it (block/tau_reference) */
     double rate_left;                                /* sigma_motion: the drift left to the pull alone (rad/s) */
     double rate_heading, rate_reference, rate_guard; /* Ts/tau_heading, Ts/tau_reference, Ts/tau_mag_guard */
     double a_heading, a_reference, a_guard;          /* 1 - exp(-Ts/tau) of each (the guard's 0 where unset) */
