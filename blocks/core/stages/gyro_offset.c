@@ -93,7 +93,7 @@ static double clipped(double x, double clip)
 
 /* scalar_update: Kalman update of the offset b (P its covariance, 3 x 3, both in place) from one
  * scalar measurement z of h.b with noise variance w */
-static void scalar_update(double b[3], double P[9], const double h[3], double z, double w)
+static inline void scalar_update(double b[3], double P[9], const double h[3], double z, double w)
 {
     double Ph[3];
     mat_vec(P, h, Ph);
@@ -101,8 +101,12 @@ static void scalar_update(double b[3], double P[9], const double h[3], double z,
     double innovation = (z - dot(h, b)) * inv_s;
     for (int i = 0; i < 3; i++) {
         b[i] += Ph[i] * innovation;
-        for (int j = 0; j < 3; j++)
-            P[3 * i + j] -= Ph[i] * Ph[j] * inv_s;
+        for (int j = i; j < 3; j++) { /* Ph[i].Ph[j] = Ph[j].Ph[i] exactly: each product once */
+            double dP = Ph[i] * Ph[j] * inv_s;
+            P[3 * i + j] -= dP;
+            if (j != i)
+                P[3 * j + i] -= dP;
+        }
     }
 }
 
@@ -199,16 +203,13 @@ static Quat unit(Quat q)
     return (Quat){q.w * k, q.x * k, q.y * k, q.z * k};
 }
 
-void gyro_offset_step(AfGyroOffset *state, const AfGyroOffsetCoef *coef, const double gyr_in[3], const double acc_in[3],
+void gyro_offset_step(AfGyroOffset *state, const AfGyroOffsetCoef *coef, const double gyr[3], const double acc[3],
                       double offset[3], double variance[3])
 {
     double Ts = coef->Ts, V = coef->V;
-    const double gyr[3] = {gyr_in[0], gyr_in[1], gyr_in[2]}, acc[3] = {acc_in[0], acc_in[1], acc_in[2]};
-    double b[3], P[9]; /* the offset estimate and its covariance, written back at the end */
-    for (int i = 0; i < 3; i++)
-        b[i] = state->b[i];
-    for (int i = 0; i < 9; i++)
-        P[i] = state->P[i];
+    /* the inputs read and the offset estimate b and its covariance P updated in place: copies on the stack,
+     * stored a double at a time and read back two at a time by the vectorised code, stall the loads */
+    double *b = state->b, *P = state->P;
     double dg2 = 0.0, da2 = 0.0, g2 = 0.0;
     for (int i = 0; i < 3; i++) {
         state->lp_gyr[i] += coef->a_lp * (gyr[i] - state->lp_gyr[i]);
@@ -259,11 +260,9 @@ void gyro_offset_step(AfGyroOffset *state, const AfGyroOffsetCoef *coef, const d
         motion_update(b, P, old, state->acc_lp[0], state->r_lp[0], state->rb_lp[0], Ts, coef->W, coef->clip);
     }
     for (int i = 0; i < 3; i++) {
-        state->b[i] = offset[i] = b[i];
+        offset[i] = b[i];
         variance[i] = P[4 * i];
     }
-    for (int i = 0; i < 9; i++)
-        state->P[i] = P[i];
 }
 
 void gyro_offset_run(AfGyroOffset *state, const AfGyroOffsetCoef *coef, size_t n, const double *gyr,
