@@ -216,9 +216,7 @@ static void heading_rows(const AfStep *step, AfState *state, size_t i, size_t j,
     for (size_t k = i; k < j; k++) {
         const double *f = mag != NULL ? mag + 3 * k : no_field;
         int accepted;
-        quat_store(heading_step(&state->heading, &step->heading_coef, quat_load(out->quat + 4 * k),
-                                (Vec3){f[0], f[1], f[2]}, &accepted),
-                   out->quat + 4 * k);
+        heading_step(&state->heading, &step->heading_coef, out->quat + 4 * k, f, out->quat + 4 * k, &accepted);
         if (out->mag_accepted != NULL)
             out->mag_accepted[k] = accepted != 0;
         if (out->mag_offset != NULL)

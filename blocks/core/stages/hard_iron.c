@@ -23,19 +23,26 @@ void hard_iron_coefficients(const double params[AF_N_PARAMS], double Ts, AfHardI
     coef->rate_recent = 1.0 / recent_steps;
 }
 
-double pull(double gap, double rate, double one_step)
-{
-    return gap == 1.0 ? one_step : 1.0 - exp(-gap * rate);
-}
-
 /* accumulate: the running sums s after the field sample m, the old sums scaled by forget */
-static void accumulate(double s[15], Vec3 m, double forget)
+static inline void accumulate(double s[15], Vec3 m, double forget)
 {
     double n2 = m.x * m.x + m.y * m.y + m.z * m.z;
-    double terms[15] = {1.0, m.x, m.y, m.z, m.x * m.x, m.x * m.y, m.x * m.z, m.y * m.y, m.y * m.z,
-                        m.z * m.z, m.x * n2, m.y * n2, m.z * n2, n2, n2 * n2};
-    for (int i = 0; i < 15; i++)
-        s[i] = forget * s[i] + terms[i];
+    /* term by term: the terms in an array go through the stack, stored one at a time and read two at a time */
+    s[0] = forget * s[0] + 1.0;
+    s[1] = forget * s[1] + m.x;
+    s[2] = forget * s[2] + m.y;
+    s[3] = forget * s[3] + m.z;
+    s[4] = forget * s[4] + m.x * m.x;
+    s[5] = forget * s[5] + m.x * m.y;
+    s[6] = forget * s[6] + m.x * m.z;
+    s[7] = forget * s[7] + m.y * m.y;
+    s[8] = forget * s[8] + m.y * m.z;
+    s[9] = forget * s[9] + m.z * m.z;
+    s[10] = forget * s[10] + m.x * n2;
+    s[11] = forget * s[11] + m.y * n2;
+    s[12] = forget * s[12] + m.z * n2;
+    s[13] = forget * s[13] + n2;
+    s[14] = forget * s[14] + n2 * n2;
 }
 
 /* covariance: the field's mean mu and covariance c (xx, xy, xz, yy, yz, zz) from the sums s, w = 1/s[0] */
@@ -133,19 +140,13 @@ static double recent(double *mean_square, Vec3 m, Vec3 centre, double r2, double
     return *mean_square;
 }
 
-/* less_offset: the field sample m less the offset in use */
-static Vec3 less_offset(Vec3 m, const AfHardIron *state)
-{
-    return (Vec3){m.x - state->offset[0], m.y - state->offset[1], m.z - state->offset[2]};
-}
-
-Vec3 hard_iron_step(AfHardIron *state, const AfHardIronCoef *coef, Vec3 m, double gap, double norm_tol,
-                    double steady_steps, int *changed)
+int hard_iron_step(AfHardIron *state, const AfHardIronCoef *coef, double mx, double my, double mz, double gap,
+                   double norm_tol, double steady_steps)
 {
     double spread_min = coef->spread_min, tol = coef->tol;
-    *changed = 0;
+    Vec3 m = {mx, my, mz};
     if (coef->cal_steps <= 0.0)
-        return m;
+        return 0;
     accumulate(state->sums, m, 1.0 - pull(gap, coef->rate_cal, coef->a_cal));
     state->age += gap;
     Fit f = fit(state->sums);
@@ -174,25 +175,26 @@ Vec3 hard_iron_step(AfHardIron *state, const AfHardIronCoef *coef, Vec3 m, doubl
          * every direction fits none): the fit starts afresh */
         accumulate(state->sums, m, 0.0);
         state->fit_steps = state->raw_steps = state->recent_fit = state->recent_raw = state->age = 0.0;
-        return less_offset(m, state);
+        return 0;
     }
+    int changed = 0;
     if (explained) {
         state->fit_steps += gap;
         state->raw_steps = 0.0;
         if (state->fit_steps >= steady_steps) {
             state->offset[0] = f.b.x, state->offset[1] = f.b.y, state->offset[2] = f.b.z;
-            *changed = !was_used;
+            changed = !was_used;
         }
     } else if (drop) {
         state->raw_steps += gap;
         state->fit_steps = 0.0;
         if (state->raw_steps >= steady_steps) {
             state->offset[0] = state->offset[1] = state->offset[2] = 0.0;
-            *changed = was_used;
+            changed = was_used;
         }
     } else {
         state->fit_steps = 0.0;
         state->raw_steps = 0.0;
     }
-    return less_offset(m, state);
+    return changed;
 }

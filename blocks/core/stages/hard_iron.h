@@ -30,12 +30,25 @@ typedef struct {
 void hard_iron_coefficients(const double params[AF_N_PARAMS], double Ts, AfHardIronCoef *coef);
 
 /* pull: 1 - exp(-gap*rate), a first-order low-pass's weight over gap steps; one_step its value for one. */
-double pull(double gap, double rate, double one_step);
+static inline double pull(double gap, double rate, double one_step)
+{
+    return gap == 1.0 ? one_step : 1.0 - exp(-gap * rate);
+}
 
-/* hard_iron_step: the field sample m (finite) less the offset estimate after updating it; *changed: 1
- * when the offset was taken or dropped at this sample. gap: steps since the last field sample;
- * norm_tol, steady_steps: the heading guard's norm tolerance and mag_new_time in steps. */
-Vec3 hard_iron_step(AfHardIron *state, const AfHardIronCoef *coef, Vec3 m, double gap, double norm_tol,
-                    double steady_steps, int *changed);
+/* hard_iron_step: the field sample (mx, my, mz) (finite) into the offset estimate state->offset;
+ * 1 when the offset was taken or dropped at this sample. gap: steps since the last field sample;
+ * norm_tol, steady_steps: the heading guard's norm tolerance and mag_new_time in steps. (The
+ * sample goes as three doubles, in registers: a 3-vector by value or by pointer goes through
+ * memory, where a copy read two doubles at a time from stores of one stalls.) */
+int hard_iron_step(AfHardIron *state, const AfHardIronCoef *coef, double mx, double my, double mz, double gap,
+                   double norm_tol, double steady_steps);
+
+/* hard_iron_removed: the field sample m less the offset estimate in use (m as it is with the fit off) */
+static inline Vec3 hard_iron_removed(const AfHardIron *state, const AfHardIronCoef *coef, Vec3 m)
+{
+    if (coef->cal_steps <= 0.0)
+        return m;
+    return (Vec3){m.x - state->offset[0], m.y - state->offset[1], m.z - state->offset[2]};
+}
 
 #endif

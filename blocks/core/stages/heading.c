@@ -316,8 +316,11 @@ static Quat about_up(double psi, Quat q)
     return quat_multiply((Quat){cos(half), 0.0, 0.0, sin(half)}, q);
 }
 
-Quat heading_step(AfHeading *state, const AfHeadingCoef *coef, Quat q, Vec3 m_sensor, int *ok)
+void heading_step(AfHeading *state, const AfHeadingCoef *coef, const double q_in[4], const double m[3], double out[4],
+                  int *ok)
 {
+    Quat q = quat_load(q_in);
+    Vec3 m_sensor = {m[0], m[1], m[2]};
     state->gap += 1.0;
     state->noise_gap += 1.0;
     if (state->seen > 0.0)
@@ -338,9 +341,9 @@ Quat heading_step(AfHeading *state, const AfHeadingCoef *coef, Quat q, Vec3 m_se
     state->psi_c += state->follow * Ts;
     double n2 = m_sensor.x * m_sensor.x + m_sensor.y * m_sensor.y + m_sensor.z * m_sensor.z;
     if (isfinite(n2) && n2 > 0.0) { /* a field sample (not NaN: missing, not all 0: none) */
-        int proven;
-        m_sensor = hard_iron_step(&state->hard_iron, &coef->hard_iron, m_sensor, state->gap, coef->norm_tol,
-                                  coef->new_steps, &proven);
+        int proven = hard_iron_step(&state->hard_iron, &coef->hard_iron, m_sensor.x, m_sensor.y, m_sensor.z,
+                                    state->gap, coef->norm_tol, coef->new_steps);
+        m_sensor = hard_iron_removed(&state->hard_iron, &coef->hard_iron, m_sensor);
         if (proven) { /* a field freed of (or back without) an offset: start afresh from it */
             state->seen = 0.0;
             restart(state, coef, 1);
@@ -353,23 +356,22 @@ Quat heading_step(AfHeading *state, const AfHeadingCoef *coef, Quat q, Vec3 m_se
         *ok = field_sample(state, coef, q, m_earth); /* turned by psi_c there */
         if (online) {
             Vec3 rate = {turn.x / Ts, turn.y / Ts, turn.z / Ts};
-            mag_delay_field_sample(&state->mag_delay, &coef->mag_delay, m_sensor, rate, *ok);
+            mag_delay_field_sample(&state->mag_delay, &coef->mag_delay, m_sensor.x, m_sensor.y, m_sensor.z, rate.x,
+                                   rate.y, rate.z, *ok);
         }
     }
     quat_store(q, state->q_prev);
     if (fabs(state->psi_c) > PI)
         state->psi_c = atan2(sin(state->psi_c), cos(state->psi_c));
-    return about_up(state->psi_c, q);
+    quat_store(about_up(state->psi_c, q), out);
 }
 
 void heading_run(AfHeading *state, const AfHeadingCoef *coef, size_t n, const double *quat, const double *mag,
                  double *out, unsigned char *accepted, double *offset, double *delay)
 {
     for (size_t k = 0; k < n; k++) {
-        const double *m = mag + 3 * k;
         int ok;
-        Quat turned = heading_step(state, coef, quat_load(quat + 4 * k), (Vec3){m[0], m[1], m[2]}, &ok);
-        quat_store(turned, out + 4 * k);
+        heading_step(state, coef, quat + 4 * k, mag + 3 * k, out + 4 * k, &ok);
         accepted[k] = (unsigned char)ok;
         for (int i = 0; i < 3; i++)
             offset[3 * k + i] = state->hard_iron.offset[i];

@@ -65,10 +65,13 @@ int heading_coefficients(const double params[AF_N_PARAMS], double Ts, AfHeadingC
 /* initial_state: nothing seen yet. */
 void heading_initial_state(AfHeading *state);
 
-/* heading_step: q (the attitude filter's orientation) turned by the updated heading correction;
- * *ok: whether the field m_sensor (a NaN: no sample this step) was used. state in place; its
- * hard_iron.offset is the hard-iron estimate, mag_delay.delay the delay allowed for (s). */
-Quat heading_step(AfHeading *state, const AfHeadingCoef *coef, Quat q, Vec3 m_sensor, int *ok);
+/* heading_step: q (the attitude filter's orientation, w x y z) turned by the updated heading correction
+ * into out (may be q); *ok: whether the field m (a NaN: no sample this step) was used. state in place;
+ * its hard_iron.offset is the hard-iron estimate, mag_delay.delay the delay allowed for (s). (Rows in
+ * and out by pointer: a quaternion returned by value goes through memory a double at a time and is read
+ * back two at a time, which stalls.) */
+void heading_step(AfHeading *state, const AfHeadingCoef *coef, const double q[4], const double m[3], double out[4],
+                  int *ok);
 
 /* heading_step over n samples: quat (rows of 4) and mag (rows of 3) in; out (rows of 4; may be quat),
  * accepted (0 or 1), offset (rows of 3: the hard-iron estimate after each) and delay (the delay

@@ -18,14 +18,6 @@ void mag_delay_coefficients(const double params[AF_N_PARAMS], double Ts, AfMagDe
     coef->weight = (1.0 - coef->lag) / Ts;
 }
 
-void mag_delay_turn(AfMagDelay *state, const AfMagDelayCoef *coef, Vec3 rotation)
-{
-    state->turn[0] += rotation.x;
-    state->turn[1] += rotation.y;
-    state->turn[2] += rotation.z;
-    state->since += coef->Ts;
-}
-
 void mag_delay_restart(AfMagDelay *state)
 {
     memset(state, 0, sizeof *state);
@@ -36,8 +28,10 @@ static Vec3 cross(Vec3 a, Vec3 b)
     return (Vec3){a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
 
-void mag_delay_field_sample(AfMagDelay *state, const AfMagDelayCoef *coef, Vec3 m, Vec3 w, int use)
+void mag_delay_field_sample(AfMagDelay *state, const AfMagDelayCoef *coef, double mx, double my, double mz, double wx,
+                            double wy, double wz, int use)
 {
+    Vec3 m = {mx, my, mz}, w = {wx, wy, wz};
     double dt = state->since, *sums = state->sums;
     if (state->seen > 0.0 && dt > 0.0) {
         double a = coef->a, one_step = dt == coef->Ts;
@@ -57,11 +51,11 @@ void mag_delay_field_sample(AfMagDelay *state, const AfMagDelayCoef *coef, Vec3 
         state->clean = use ? state->clean + dt : 0.0;
         if (use && state->clean >= MAG_DELAY_CLEAN_S) {
             double forget = one_step ? coef->forget : exp(-coef->rate * dt);
-            double terms[4] = {y_lp[0] * j_lp[0] + y_lp[1] * j_lp[1] + y_lp[2] * j_lp[2],
-                               j_lp[0] * j_lp[0] + j_lp[1] * j_lp[1] + j_lp[2] * j_lp[2],
-                               y_lp[0] * y_lp[0] + y_lp[1] * y_lp[1] + y_lp[2] * y_lp[2], 1.0};
-            for (int i = 0; i < 4; i++)
-                sums[i] = forget * sums[i] + terms[i] * dt;
+            /* term by term (an array of the terms goes through the stack: stored one at a time, read two at a time) */
+            sums[0] = forget * sums[0] + (y_lp[0] * j_lp[0] + y_lp[1] * j_lp[1] + y_lp[2] * j_lp[2]) * dt;
+            sums[1] = forget * sums[1] + (j_lp[0] * j_lp[0] + j_lp[1] * j_lp[1] + j_lp[2] * j_lp[2]) * dt;
+            sums[2] = forget * sums[2] + (y_lp[0] * y_lp[0] + y_lp[1] * y_lp[1] + y_lp[2] * y_lp[2]) * dt;
+            sums[3] = forget * sums[3] + 1.0 * dt;
             if (sums[1] > 0.0 && sums[3] >= MAG_DELAY_MIN_S) {
                 /* d = s_yj/s_jj, the mean square residual <|y - d.j|^2> = (s_yy - d.s_yj)/s_t; |d| >= k.SE with
                  * SE^2 = (2/a).(residual/3)/s_jj, both sides times s_jj.s_t (> 0) */

@@ -39,15 +39,23 @@ typedef struct {
 void mag_delay_coefficients(const double params[AF_N_PARAMS], double Ts, AfMagDelayCoef *coef);
 
 /* turn: every step, the step's rotation (rad) added to the integrated rate. */
-void mag_delay_turn(AfMagDelay *state, const AfMagDelayCoef *coef, Vec3 rotation);
+static inline void mag_delay_turn(AfMagDelay *state, const AfMagDelayCoef *coef, Vec3 rotation)
+{
+    state->turn[0] += rotation.x;
+    state->turn[1] += rotation.y;
+    state->turn[2] += rotation.z;
+    state->since += coef->Ts;
+}
 
 /* restart: every sample forgotten, the delay in use reset to 0 (a hard-iron offset taken or dropped). */
 void mag_delay_restart(AfMagDelay *state);
 
-/* field_sample: a field sample m (sensor frame, hard iron removed) with the step's rate w (rad/s);
+/* field_sample: a field sample m = (mx, my, mz) (sensor frame, hard iron removed) with the step's rate
+ * w = (wx, wy, wz) (rad/s; as doubles, in registers, like hard_iron_step's);
  * the interval since the last one enters the estimate when use (the guard accepted it) and the
  * guard accepted every field sample over the last MAG_DELAY_CLEAN_S (the low-passes then hold
  * no refused field: a disturbance's edge would pass for a delay). */
-void mag_delay_field_sample(AfMagDelay *state, const AfMagDelayCoef *coef, Vec3 m, Vec3 w, int use);
+void mag_delay_field_sample(AfMagDelay *state, const AfMagDelayCoef *coef, double mx, double my, double mz, double wx,
+                            double wy, double wz, int use);
 
 #endif
