@@ -53,15 +53,15 @@ void gyro_offset_initial_state(const AfGyroOffsetCoef *coef, const double gyr0[3
     state->q[0] = 1.0;
 }
 
-/* lowpass_rows: the Butterworth's two state rows (value, rate; width columns each) after the inputs x */
-static inline void lowpass_rows(double *restrict value, double *restrict rate, int width, const double *restrict x,
-                                const double Ad[4], const double Bd[2])
+/* lowpass: a column of the Butterworth's two state rows (value, rate) after the input x. Called column by
+ * column with inputs held in variables: a loop over an array of inputs keeps the array on the stack,
+ * stored a double at a time and read two at a time, which stalls the reads. */
+static inline void lowpass(double *restrict value, double *restrict rate, double x, const double Ad[4],
+                           const double Bd[2])
 {
-    for (int j = 0; j < width; j++) {
-        double x0 = value[j], x1 = rate[j];
-        value[j] = Ad[0] * x0 + Ad[1] * x1 + Bd[0] * x[j];
-        rate[j] = Ad[2] * x0 + Ad[3] * x1 + Bd[1] * x[j];
-    }
+    double x0 = *value, x1 = *rate;
+    *value = Ad[0] * x0 + Ad[1] * x1 + Bd[0] * x;
+    *rate = Ad[2] * x0 + Ad[3] * x1 + Bd[1] * x;
 }
 
 static double dot(const double u[3], const double v[3])
@@ -231,21 +231,29 @@ void gyro_offset_step(AfGyroOffset *state, const AfGyroOffsetCoef *coef, const d
         quat_store(q, state->q);
         double t = state->t += Ts;
         /* the accelerometer, R.b and R (row-major) low-passed */
-        double R[9], a[3], rb[3];
+        double R[9];
         quat_matrix(q, R);
-        mat_vec(R, acc, a);
-        mat_vec(R, b, rb);
+        Vec3 a = {R[0] * acc[0] + R[1] * acc[1] + R[2] * acc[2], R[3] * acc[0] + R[4] * acc[1] + R[5] * acc[2],
+                  R[6] * acc[0] + R[7] * acc[1] + R[8] * acc[2]}; /* R.acc (mat_vec's sums, in variables) */
+        Vec3 rb = {R[0] * b[0] + R[1] * b[1] + R[2] * b[2], R[3] * b[0] + R[4] * b[1] + R[5] * b[2],
+                   R[6] * b[0] + R[7] * b[1] + R[8] * b[2]};
+        double *acc_lp = state->acc_lp[0], *acc_rate = state->acc_lp[1];
         if (t <= coef->tau_acc) { /* the running mean, derivative row at rest */
             double w = Ts / t;
-            for (int i = 0; i < 3; i++) {
-                state->acc_lp[0][i] += w * (a[i] - state->acc_lp[0][i]);
-                state->acc_lp[1][i] = 0.0;
-            }
+            acc_lp[0] += w * (a.x - acc_lp[0]);
+            acc_lp[1] += w * (a.y - acc_lp[1]);
+            acc_lp[2] += w * (a.z - acc_lp[2]);
+            acc_rate[0] = acc_rate[1] = acc_rate[2] = 0.0;
         } else {
-            lowpass_rows(state->acc_lp[0], state->acc_lp[1], 3, a, coef->Ad, coef->Bd);
+            lowpass(&acc_lp[0], &acc_rate[0], a.x, coef->Ad, coef->Bd);
+            lowpass(&acc_lp[1], &acc_rate[1], a.y, coef->Ad, coef->Bd);
+            lowpass(&acc_lp[2], &acc_rate[2], a.z, coef->Ad, coef->Bd);
         }
-        lowpass_rows(state->r_lp[0], state->r_lp[1], 9, R, coef->Ad, coef->Bd);
-        lowpass_rows(state->rb_lp[0], state->rb_lp[1], 3, rb, coef->Ad, coef->Bd);
+        for (int i = 0; i < 9; i++)
+            lowpass(&state->r_lp[0][i], &state->r_lp[1][i], R[i], coef->Ad, coef->Bd);
+        lowpass(&state->rb_lp[0][0], &state->rb_lp[1][0], rb.x, coef->Ad, coef->Bd);
+        lowpass(&state->rb_lp[0][1], &state->rb_lp[1][1], rb.y, coef->Ad, coef->Bd);
+        lowpass(&state->rb_lp[0][2], &state->rb_lp[1][2], rb.z, coef->Ad, coef->Bd);
     }
     for (int i = 0; i < 3; i++) {
         double p = P[4 * i] + V;
