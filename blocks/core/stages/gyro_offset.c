@@ -142,8 +142,7 @@ static void motion_update(double b[3], double P[9], const double old[3], const d
     double e0[3], e1[3], e2[3];
     across(new, e0);
     double norm = sqrt(n2);
-    for (int i = 0; i < 3; i++)
-        e1[i] = norm * e0[i];
+    e1[0] = norm * e0[0], e1[1] = norm * e0[1], e1[2] = norm * e0[2];
     e2[0] = new[1] * e0[2] - new[2] * e0[1];
     e2[1] = new[2] * e0[0] - new[0] * e0[2];
     e2[2] = new[0] * e0[1] - new[1] * e0[0];
@@ -156,9 +155,10 @@ static void motion_update(double b[3], double P[9], const double old[3], const d
     mat_vec(r_lp, b, Lb);
     double d[3] = {rb_lp[0] - Lb[0], rb_lp[1] - Lb[1], rb_lp[2] - Lb[2]}; /* LP(R.b) - LP(R).b, across gravity below */
     double along = dot(d, new) / n2;
-    double e[3];
-    for (int i = 0; i < 3; i++)
-        e[i] = clipped(turn[i] + d[i] - along * new[i], clip);
+    /* written out element by element, as below: an array filled in a loop is kept on the stack, stored a
+     * double at a time and read back in pairs (a store-forwarding stall on the path to the next sample) */
+    double e[3] = {clipped(turn[0] + d[0] - along * new[0], clip), clipped(turn[1] + d[1] - along * new[1], clip),
+                   clipped(turn[2] + d[2] - along * new[2], clip)};
     /* M = (e1, e2)^T.LP(R), 2 x 3; the eigenvectors of M.M^T are H's left singular directions */
     double m1[3], m2[3];
     mat_t_vec(r_lp, e1, m1);
@@ -182,11 +182,8 @@ static void motion_update(double b[3], double P[9], const double old[3], const d
         }
         if (mean + (a == 0 ? radius : -radius) < OBSERVED * OBSERVED * k2)
             continue;
-        double u[3], h[3];
-        for (int i = 0; i < 3; i++) {
-            u[i] = c * e1[i] + sn * e2[i];
-            h[i] = c * m1[i] + sn * m2[i]; /* H^T.u */
-        }
+        double u[3] = {c * e1[0] + sn * e2[0], c * e1[1] + sn * e2[1], c * e1[2] + sn * e2[2]};
+        double h[3] = {c * m1[0] + sn * m2[0], c * m1[1] + sn * m2[1], c * m1[2] + sn * m2[2]}; /* H^T.u */
         /* u.e measures h.b at the b the innovation was taken at; later directions see the update */
         double z = dot(u, e) + dot(h, b0);
         scalar_update(b, P, h, z, W * L2 * k2);
