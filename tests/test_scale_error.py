@@ -171,6 +171,28 @@ def test_a_recording_no_longer_than_the_horizon_keeps_the_default(n):
         assert est.chosen is not None
 
 
+@pytest.mark.parametrize("sensor, best", [("calibrated", 0.0), ("low_range", DEFAULT)])
+def test_a_long_recording_is_chosen_on_its_windows_alone(sensor, best):
+    """30 min with a magnetometer: the choice runs on scale_error.subset's rows alone, as many
+    whatever the length (WINDOWS·(WARM_UP_S + SCORED_S)·fs): every other row replaced by a
+    steady turn leaves scale_error and tau_heading as they were, and the choice is the
+    sensor's (0 for a calibrated gyro, the default for one of 1 %); a recording no longer
+    than the windows is used whole (subset None)."""
+    rec = simulate_recording(FS, 1800.0, 10.0, SENSORS[sensor], seed=3)
+    rows, windows = scale_error.subset(len(rec.gyr), rec.fs)
+    cap = scale_error.WINDOWS * round((scale_error.WARM_UP_S + scale_error.SCORED_S) * FS)
+    assert len(rows) == cap == windows[-1][2] and len(set(rows)) == cap
+    assert scale_error.subset(cap, FS) is None and scale_error.subset(cap + 1, FS) is not None
+    outside = np.ones(len(rec.gyr), dtype=bool)
+    outside[rows] = False
+    gyr, acc = rec.gyr.copy(), rec.acc.copy()
+    gyr[outside], acc[outside] = [0.0, 0.0, 1.0], [0.0, 0.0, G]
+    est = estimate(rec.gyr, rec.acc, rec.fs, mag=rec.mag)
+    print(sensor, est.chosen)
+    assert est.chosen["scale_error"] == best
+    assert estimate(gyr, acc, rec.fs, mag=rec.mag).chosen == est.chosen
+
+
 def test_offline_the_same_choice_is_made_and_used():
     """offline=True: the choice of the causal path, and the offline estimate with it given."""
     rec = _recording("calibrated", 0)
@@ -211,9 +233,9 @@ def test_the_command_line_says_what_it_chose(tmp_path, capsys):
     assert "chosen" not in json.loads(capsys.readouterr().out)
 
 
-def test_the_candidates_on_threads_choose_as_one_thread_does():
-    """The candidates run at once on threads (threads=None or 2) or one after another (threads=1):
-    the same choice, the same estimate bit for bit."""
+def test_the_choice_is_the_same_on_any_threads():
+    """threads (the causal pipeline's; the candidates run one after another) 1, 2 or None: the
+    same choice, the same estimate bit for bit."""
     rec = _recording("calibrated", 1)
     one = estimate(rec.gyr, rec.acc, rec.fs, threads=1)
     for threads in (2, None):
