@@ -133,7 +133,9 @@ def estimate(
     gyro offset, or with heading up to the method, on one; the rest on the other), the
     outputs bit for bit those of one thread; None (automatic): two for 20 000 rows or more
     where the process may run on two CPUs or more and the gyro offset or the heading runs.
-    Pass 1 where processes already use every CPU (one estimate per worker).
+    The candidates of scale_error's choice (below) run on up to this many threads at once
+    (None: one per CPU the process may run on). Pass 1 where processes already use every CPU
+    (one estimate per worker).
 
     scale_error (wiener with its local densities): unless given, chosen from the recording
     (blocks.stages.scale_error: of its candidates, the one whose estimate predicts the
@@ -163,7 +165,7 @@ def estimate(
         gyr, acc, mag = gyr[start:], acc[start:], None if mag is None else mag[start:]
     chosen = None
     if scale_error.applies(method, dict(pipeline.params)):
-        found = _chosen_scale_error(pipeline, step, gyr, acc, initial_gravity)
+        found = _chosen_scale_error(pipeline, step, gyr, acc, initial_gravity, threads)
         if found is not None:
             chosen = {"scale_error": found[0]}
             if pipeline.heading_params is not None and "tau_heading" not in pipeline.heading_params:
@@ -181,7 +183,8 @@ def estimate(
     return held_before(est, start)
 
 
-def _chosen_scale_error(pipeline: Pipeline, step: Step, gyr, acc, initial_gravity) -> tuple[float, float, float] | None:
+def _chosen_scale_error(pipeline: Pipeline, step: Step, gyr, acc, initial_gravity,
+                        threads: int | None) -> tuple[float, float, float] | None:
     """blocks.stages.scale_error's choice for the pipeline's method, with the gyro's mean square
     rate ⟨|ω|²⟩ (rad²/s²) and the mean variance of the offset removed from it ((rad/s)², 0 with
     no offset stage) over the rows it scored (None: the recording is too short): the method
@@ -189,7 +192,8 @@ def _chosen_scale_error(pipeline: Pipeline, step: Step, gyr, acc, initial_gravit
     its offset by a forward pass), over the windows of scale_error.subset, one after another
     (each from the start at rest on its first rows, its warm-up with the method's default
     scale_error, each candidate on from there), or over every row from initial_gravity where
-    that is None."""
+    that is None; candidates on up to threads threads at once (None: a thread for each CPU the
+    process may run on)."""
     fs = 1.0 / step.Ts
     gyr = interval_means(gyr) if pipeline.point_gyr else gyr
     acc = interval_ends(gyr, acc, step.Ts) if pipeline.mean_acc else acc
@@ -222,7 +226,7 @@ def _chosen_scale_error(pipeline: Pipeline, step: Step, gyr, acc, initial_gravit
                                   initial_gravity=initial_gravity, threads=1).gravity
         return out
 
-    found = scale_error.choose(gyr, acc, fs, candidate, windows)
+    found = scale_error.choose(gyr, acc, fs, candidate, windows, _core.cpus() if threads is None else threads)
     if found is None:
         return None
     counted = np.concatenate([np.arange(scored, end) for _, scored, end in spans])
