@@ -79,6 +79,62 @@ def test_the_criterion_is_scipys_on_random_rows(m):
             _criterion(gyr, acc, gravity, 1.0 / fs, horizon), rel=1e-9)
 
 
+@pytest.mark.parametrize("block", [1, 37, 350, 351, 1000])
+def test_the_block_means_are_scipys_over_each_block(block):
+    """prediction_errors: the criterion's squared differences (scipy's rotations) averaged over
+    consecutive blocks of the k ≥ m, the last holding those left over, within 1e-9; one block
+    of every row is prediction_error."""
+    rng = np.random.default_rng(block)
+    n, m, Ts = 400, 50, 1.0 / FS
+    gyr = rng.uniform(-3.0, 3.0, (n, 3))
+    acc = rng.normal(0.0, 4.0, (n, 3)) + [0.0, 0.0, G]
+    gravity = rng.normal(0.0, 2.0, (n, 3)) + [0.0, 0.0, G]
+    turns = Rotation.from_rotvec(gyr * Ts)
+    frames = [turns[0]]
+    for turn in turns[1:]:
+        frames.append(frames[-1] * turn)
+    frames = Rotation.concatenate(frames)
+    squared = np.sum((frames.apply(acc)[m:] - frames.apply(gravity)[:-m]) ** 2, axis=1)
+    expected = [np.mean(squared[i:i + block]) for i in range(0, n - m, block)]
+    got = _core.prediction_errors(gyr, acc, gravity, Ts, m, block)
+    assert got == pytest.approx(expected, rel=1e-9)
+    if block >= n - m:
+        assert got[0] == _core.prediction_error(gyr, acc, gravity, Ts, m)
+    with pytest.raises(ValueError, match="block must be 1 sample or more"):
+        _core.prediction_errors(gyr, acc, gravity, Ts, m, 0)
+
+
+@pytest.mark.parametrize("z, taken", [(-3.0, True), (-scale_error.SIGNIFICANCE - 0.05, True),
+                                      (-scale_error.SIGNIFICANCE + 0.05, False), (0.0, False), (2.0, False)])
+def test_a_lower_candidate_is_taken_only_where_its_blocks_show_it(z, taken):
+    """scale_error.choose compares each candidate's block errors with the default's, pair by pair.
+    A still sensor, the accelerometer gravity alone; the default's estimate is off by D on z,
+    0's by D + δ_j in block j, so that its block errors differ from the default's by
+    (D + δ_j)² − D² = s + ε·(−1)^j over 12 blocks (s.e. of the mean ε/√11); 0.001 and 0.002 are
+    far worse. 0 is taken where s lies more than SIGNIFICANCE standard errors below 0, here s =
+    z·ε/√11."""
+    blocks, D, noise = 12, 0.1, 1e-4
+    block, m = round(scale_error.BLOCK_S * FS), HORIZON
+    n = blocks * block + m
+    gyr, acc = np.zeros((n, 3)), np.tile([0.0, 0.0, G], (n, 1))
+    differences = z * noise / math.sqrt(blocks - 1) + noise * (-1.0) ** np.arange(blocks)
+    default = np.tile([0.0, 0.0, G + D], (n, 1))
+
+    def run(candidate: float) -> np.ndarray:
+        if candidate == DEFAULT:
+            return default
+        out = default + [0.0, 0.0, 1.0]
+        if candidate == 0.0:  # the estimate at k − m predicts row k: block j's rows of estimate
+            for j, difference in enumerate(differences):
+                out[j * block:(j + 1) * block, 2] = G + math.sqrt(D**2 + difference)
+        return out
+
+    found, errors = scale_error.choose(gyr, acc, FS, run)
+    assert errors[DEFAULT] == pytest.approx(D**2, rel=1e-12)
+    assert errors[0.0] - errors[DEFAULT] == pytest.approx(np.mean(differences), rel=1e-6, abs=1e-15)
+    assert found == (0.0 if taken else DEFAULT)
+
+
 @pytest.mark.parametrize("theta", [0.0, 0.1, 1.0])
 def test_a_steady_turn_leaves_only_the_estimates_tilt(theta):
     """A sensor turning at a constant rate (about an axis off the vertical) from a tilted
@@ -171,6 +227,28 @@ def test_a_recording_no_longer_than_the_horizon_keeps_the_default(n):
         assert est.chosen is not None
 
 
+@pytest.mark.parametrize("sensor, best", [("calibrated", 0.0), ("low_range", DEFAULT)])
+def test_a_long_recording_is_chosen_on_its_windows_alone(sensor, best):
+    """30 min with a magnetometer: the choice runs on scale_error.subset's rows alone, as many
+    whatever the length (WINDOWS·(WARM_UP_S + SCORED_S)·fs): every other row replaced by a
+    steady turn leaves scale_error and tau_heading as they were, and the choice is the
+    sensor's (0 for a calibrated gyro, the default for one of 1 %); a recording no longer
+    than the windows is used whole (subset None)."""
+    rec = simulate_recording(FS, 1800.0, 10.0, SENSORS[sensor], seed=3)
+    rows, windows = scale_error.subset(len(rec.gyr), rec.fs)
+    cap = scale_error.WINDOWS * round((scale_error.WARM_UP_S + scale_error.SCORED_S) * FS)
+    assert len(rows) == cap == windows[-1][2] and len(set(rows)) == cap
+    assert scale_error.subset(cap, FS) is None and scale_error.subset(cap + 1, FS) is not None
+    outside = np.ones(len(rec.gyr), dtype=bool)
+    outside[rows] = False
+    gyr, acc = rec.gyr.copy(), rec.acc.copy()
+    gyr[outside], acc[outside] = [0.0, 0.0, 1.0], [0.0, 0.0, G]
+    est = estimate(rec.gyr, rec.acc, rec.fs, mag=rec.mag)
+    print(sensor, est.chosen)
+    assert est.chosen["scale_error"] == best
+    assert estimate(gyr, acc, rec.fs, mag=rec.mag).chosen == est.chosen
+
+
 def test_offline_the_same_choice_is_made_and_used():
     """offline=True: the choice of the causal path, and the offline estimate with it given."""
     rec = _recording("calibrated", 0)
@@ -211,9 +289,9 @@ def test_the_command_line_says_what_it_chose(tmp_path, capsys):
     assert "chosen" not in json.loads(capsys.readouterr().out)
 
 
-def test_the_candidates_on_threads_choose_as_one_thread_does():
-    """The candidates run at once on threads (threads=None or 2) or one after another (threads=1):
-    the same choice, the same estimate bit for bit."""
+def test_the_choice_is_the_same_on_any_threads():
+    """threads (the causal pipeline's; the candidates run one after another) 1, 2 or None: the
+    same choice, the same estimate bit for bit."""
     rec = _recording("calibrated", 1)
     one = estimate(rec.gyr, rec.acc, rec.fs, threads=1)
     for threads in (2, None):

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
+from copy import copy
 from dataclasses import dataclass
 
 import numpy as np
@@ -184,27 +185,53 @@ def estimate(
 
 def _chosen_scale_error(pipeline: Pipeline, step: Step, gyr, acc, initial_gravity,
                         threads: int | None) -> tuple[float, float, float] | None:
-    """blocks.stages.scale_error's choice for the pipeline's method over the rows, with the
-    gyro's mean square rate ⟨|ω|²⟩ (rad²/s²) it was made on and the mean variance of the
-    offset removed from it ((rad/s)², 0 with no offset stage) (None: the recording is too
-    short): the method alone, on the samples as the pipeline turns them (its sample
-    conventions, the gyro freed of its offset by the forward pass); candidates on up to
-    threads threads at once (None: a thread for each CPU the process may run on)."""
+    """blocks.stages.scale_error's choice for the pipeline's method, with the gyro's mean square
+    rate ⟨|ω|²⟩ (rad²/s²) and the mean variance of the offset removed from it ((rad/s)², 0 with
+    no offset stage) over the rows it scored (None: the recording is too short): the method
+    alone, on the samples as the pipeline turns them (its sample conventions, the gyro freed of
+    its offset by a forward pass), over the windows of scale_error.subset, one after another
+    (each from the start at rest on its first rows, its warm-up with the method's default
+    scale_error, each candidate on from there), or over every row from initial_gravity where
+    that is None; candidates on up to threads threads at once (None: a thread for each CPU the
+    process may run on)."""
     fs = 1.0 / step.Ts
     gyr = interval_means(gyr) if pipeline.point_gyr else gyr
     acc = interval_ends(gyr, acc, step.Ts) if pipeline.mean_acc else acc
-    offset_variance = 0.0
+    found = scale_error.subset(len(gyr), fs)
+    windows = None
+    if found is not None:
+        rows, windows = found
+        gyr, acc, initial_gravity = gyr[rows], acc[rows], None
+    spans = windows or [(0, 0, len(gyr))]
+    variance = np.zeros_like(gyr)
     if pipeline.offset_params is not None:
         offset, variance = offset_estimate(gyr, acc, fs, pipeline.offset_params)
-        gyr, offset_variance = gyr - offset, float(np.mean(variance))
+        gyr = gyr - offset
     own = dict(pipeline.params)
 
-    def gravity(value: float) -> np.ndarray:
-        return estimate(gyr, acc, fs, pipeline.method, {**own, "scale_error": value}, initial_gravity,
-                        gyro_offset=False, threads=1).gravity
+    def alone(params) -> tuple[Pipeline, Step]:
+        method = configure(pipeline.method, params, gyro_offset=False)
+        return method, at(method, step.Ts)
 
-    found = scale_error.choose(gyr, acc, fs, gravity, _core.cpus() if threads is None else threads)
-    return None if found is None else (found[0], float(np.mean(np.einsum("ij,ij->i", gyr, gyr))), offset_variance)
+    default, gravity, states = alone(own), np.empty_like(gyr), []  # the warm-ups' estimates; each window's state after
+    for first, scored, _ in spans:
+        states.append(State())
+        if scored > first:
+            gravity[first:scored] = run(*default, states[-1], gyr[first:scored], acc[first:scored], threads=1).gravity
+
+    def candidate(value: float) -> np.ndarray:
+        out, method = gravity.copy(), alone({**own, "scale_error": value})
+        for (_, scored, end), state in zip(spans, states):
+            out[scored:end] = run(*method, copy(state), gyr[scored:end], acc[scored:end],
+                                  initial_gravity=initial_gravity, threads=1).gravity
+        return out
+
+    found = scale_error.choose(gyr, acc, fs, candidate, windows, _core.cpus() if threads is None else threads)
+    if found is None:
+        return None
+    counted = np.concatenate([np.arange(scored, end) for _, scored, end in spans])
+    return (found[0], float(np.mean(np.einsum("ij,ij->i", gyr[counted], gyr[counted]))),
+            float(np.mean(variance[counted])))
 
 
 def _chosen_tau_heading(pipeline: Pipeline, value: float, rate_ms: float, offset_variance: float) -> float:

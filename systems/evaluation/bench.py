@@ -39,8 +39,8 @@ def _runners(gyr, acc, mag):
                            "install them with: pip install 'attitude-fmu[peers]'") from None
     Ts = 1.0 / BENCH_FS
     return {
-        # the filter alone: local noise densities (the default: scale_error chosen from the recording, four
-        # runs more; held, as online and in the FMU), and stationary
+        # the filter alone: local noise densities (the default: scale_error chosen from the recording, the
+        # candidates on 80 s of it; held, as online and in the FMU), and stationary
         "wiener": lambda: estimate(gyr, acc, BENCH_FS, gyro_offset=False),
         "wiener_held": lambda: estimate(gyr, acc, BENCH_FS, "wiener", {"scale_error": 0.005}, gyro_offset=False),
         "wiener_stationary": lambda: estimate(gyr, acc, BENCH_FS, "wiener", {"stationary": 1}, gyro_offset=False),

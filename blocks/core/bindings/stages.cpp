@@ -283,7 +283,8 @@ void bind_stages(nb::module_ &m)
           "Per span j: matrices[j] = R_Δᵀ, R_Δ the sensor's turn from the fractional sample index x0[j] to\n"
           "x1[j] (held within the recording); quat (N×4): the sensor at t_k integrated from gyr (N×3, rad/s,\n"
           "over Ts s each).");
-    m.def("prediction_error", [](const Rows3 &gyr, const Rows3 &acc, const Rows3 &gravity, double Ts, size_t horizon) {
+    // the checks of a prediction's arguments (blocks/core/stages/prediction.h), before the lock is released
+    auto check_prediction = [](const Rows3 &gyr, const Rows3 &acc, const Rows3 &gravity, double Ts, size_t horizon) {
         size_t n = gyr.shape(0);
         check_rows(acc.shape(0), n, "acc");
         check_rows(gravity.shape(0), n, "gravity");
@@ -291,6 +292,11 @@ void bind_stages(nb::module_ &m)
         if (horizon < 1 || horizon >= n)
             throw nb::value_error(("the horizon must be 1 to " + std::to_string(n) + " - 1 samples, got " +
                                    std::to_string(horizon)).c_str());
+        return n;
+    };
+    m.def("prediction_error", [check_prediction](const Rows3 &gyr, const Rows3 &acc, const Rows3 &gravity, double Ts,
+                                                 size_t horizon) {
+        size_t n = check_prediction(gyr, acc, gravity, Ts, horizon);
         std::vector<double> work(3 * horizon);
         nb::gil_scoped_release unlocked;
         return prediction_error(n, gyr.data(), acc.data(), gravity.data(), Ts, horizon, work.data());
@@ -298,4 +304,18 @@ void bind_stages(nb::module_ &m)
           "The mean over k ≥ horizon of |acc[k] − R_kᵀ·R_(k−horizon)·gravity[k−horizon]|² (m²/s⁴), R_k the\n"
           "sensor's orientation integrated from gyr (N×3, rad/s, over Ts s each); acc and gravity N×3, m/s²\n"
           "(blocks/core/stages/prediction.h).");
+    m.def("prediction_errors", [check_prediction](const Rows3 &gyr, const Rows3 &acc, const Rows3 &gravity,
+                                                  double Ts, size_t horizon, size_t block) {
+        size_t n = check_prediction(gyr, acc, gravity, Ts, horizon);
+        if (block < 1) throw nb::value_error("block must be 1 sample or more");
+        std::vector<double> work(3 * horizon);
+        auto means = new_vector((n - horizon + block - 1) / block);
+        {
+            nb::gil_scoped_release unlocked;
+            prediction_errors(n, gyr.data(), acc.data(), gravity.data(), Ts, horizon, block, work.data(), means.data());
+        }
+        return means;
+    }, nb::arg("gyr"), nb::arg("acc"), nb::arg("gravity"), nb::arg("Ts"), nb::arg("horizon"), nb::arg("block"),
+          "prediction_error's squared differences, their means over consecutive blocks of `block` of the k ≥\n"
+          "horizon (the last holds those left over) (m²/s⁴; blocks/core/stages/prediction.h).");
 }

@@ -3,12 +3,13 @@
 
 #include "quaternion.h"
 
-double prediction_error(size_t n, const double *gyr, const double *acc, const double *gravity, double Ts, size_t m,
-                        double *work)
+size_t prediction_errors(size_t n, const double *gyr, const double *acc, const double *gravity, double Ts, size_t m,
+                         size_t block, double *work, double *means)
 {
-    if (n <= m || m == 0) return -1.0;
+    if (n <= m || m == 0 || block == 0) return 0;
     Quat q = {1.0, 0.0, 0.0, 0.0}; /* the sensor's frame at t_k in that at t_0 */
     double sum = 0.0;
+    size_t blocks = 0, counted = 0;
     for (size_t k = 0; k < n; k++) {
         const double *w = gyr + 3 * k, *a = acc + 3 * k, *g = gravity + 3 * k;
         double *held = work + 3 * (k % m); /* g_(k-m) in the frame at t_0, then g_k */
@@ -17,9 +18,20 @@ double prediction_error(size_t n, const double *gyr, const double *acc, const do
             Vec3 y = quat_rotate(q, (Vec3){a[0], a[1], a[2]});
             double dx = y.x - held[0], dy = y.y - held[1], dz = y.z - held[2];
             sum += dx * dx + dy * dy + dz * dz;
+            if (++counted == block || k == n - 1) {
+                means[blocks++] = sum / (double)counted;
+                sum = 0.0, counted = 0;
+            }
         }
         Vec3 up = quat_rotate(q, (Vec3){g[0], g[1], g[2]});
         held[0] = up.x, held[1] = up.y, held[2] = up.z;
     }
-    return sum / (double)(n - m);
+    return blocks;
+}
+
+double prediction_error(size_t n, const double *gyr, const double *acc, const double *gravity, double Ts, size_t m,
+                        double *work)
+{
+    double mean;
+    return prediction_errors(n, gyr, acc, gravity, Ts, m, n > m ? n - m : 1, work, &mean) ? mean : -1.0;
 }

@@ -15,4 +15,10 @@
 double prediction_error(size_t n, const double *gyr, const double *acc, const double *gravity, double Ts, size_t m,
                         double *work);
 
+/* prediction_errors: the same squared differences, their means over consecutive blocks of `block` of the
+ * k >= m in means (the last block holds those left over, block or fewer); the number of blocks, at most
+ * ceil((n - m)/block) (0 where n <= m, m == 0 or block == 0). */
+size_t prediction_errors(size_t n, const double *gyr, const double *acc, const double *gravity, double Ts, size_t m,
+                         size_t block, double *work, double *means);
+
 #endif
