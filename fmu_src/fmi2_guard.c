@@ -417,7 +417,7 @@ EXPORT fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, si
         fmi2Status status = inner.name args;                                                                       \
         if (status < g->logged) status = g->logged;                                                                \
         if (status == fmi2Fatal) g->fatal = 1;                                                                     \
-        else if (status <= fmi2Warning && next) g->phase = next;                                                   \
+        else if (status <= fmi2Warning && next != KEEP) g->phase = next;                                           \
         return status;                                                                                             \
     }
 FMI2_CALLS(FORWARD)
