@@ -29,7 +29,7 @@ where the least error took 0.002 (up to 8 % above 0.005's error). Calibrated gyr
 2.3 standard errors below it on a minute and are still taken. On BROAD the rule at 0.5 holds
 every mean or betters it; at 1.0 offline inclination lost 0.0004°, at 1.5 0.0025°.
 
-Where: a recording longer than WINDOWS·(WARM_UP_S + SCORED_S) (80 s) is not run whole but on
+Where: a recording longer than WINDOWS·(WARM_UP_S + SCORED_S) (140 s) is not run whole but on
 WINDOWS windows (subset), one after another, each at the start of one of as many equal parts:
 the first holds the recording's start, where a rest lets the offset pass (carried from
 window to window) find the gyro's offset (windows in the parts' middles missed it, and chose
@@ -39,11 +39,12 @@ filter's time constant, and on BROAD a window's estimate is within 0.3° of the 
 after 10 s in 9 windows of 10 (0.01° in half; 7° at the start), while warm-ups of 3 and 5 s
 chose worse (inclination 0.84° against 0.70°). Every candidate then goes on from that state
 over SCORED_S, scored. The candidates' errors differ by 10⁻⁴ of their size on simulated
-motion, so the choice wants about a minute scored: 2 × 30 s chose as the whole recording did
-on the simulated sensors above and on 30 min of each, and held BROAD's means; 2 × 5 s and
-2 × 15 s did not, 3 × 25 s and 4 × 20 s lost BROAD 0.003° of inclination. The cost is the
-cap's, whatever the recording's length: at 100 Hz about 5 ms (8000 rows of the offset pass,
-2000 of the default, 6000 of each candidate).
+motion, so the choice wants minutes scored: 2 × 60 s chose as the whole recording did on the
+simulated sensors above (300 s at 40 and 125 Hz, δv 0.1 and 0.3) and held or bettered BROAD's
+means; with the rule, 2 × 30 s took 0.002 for the 0.5 % sensor (0.47° against 0.44°), 2 × 45 s
+0.001 (0.50°), 4 × 30 s 0.002; 2 × 5 s and 2 × 15 s did not either. The cost is the cap's,
+whatever the recording's length: at 100 Hz about 10 ms (14000 rows of the offset pass, 2000 of
+the default, 12000 of each candidate).
 """
 from __future__ import annotations
 
@@ -58,7 +59,7 @@ SCALE_ERRORS = (0.0, 0.001, 0.002, 0.005)  # the candidates: the default and bel
 PREDICTION_HORIZON_S = 0.5  # s: beyond the white noise's and a tap's correlation, within the filter's memory
 WINDOWS = 2  # windows of a recording longer than their total the choice runs on (see above)
 WARM_UP_S = 10.0  # s: each window's start, run with the default alone, not scored
-SCORED_S = 30.0  # s: each window's rest, run with every candidate and scored
+SCORED_S = 60.0  # s: each window's rest, run with every candidate and scored
 BLOCK_S = 5.0  # s: the rows scored are compared candidate against default block by block
 SIGNIFICANCE = 0.5  # standard errors of the blocks' mean difference a candidate must lie below the default by
 

@@ -40,7 +40,7 @@ def _runners(gyr, acc, mag):
     Ts = 1.0 / BENCH_FS
     return {
         # the filter alone: local noise densities (the default: scale_error chosen from the recording, the
-        # candidates on 80 s of it; held, as online and in the FMU), and stationary
+        # candidates on 140 s of it; held, as online and in the FMU), and stationary
         "wiener": lambda: estimate(gyr, acc, BENCH_FS, gyro_offset=False),
         "wiener_held": lambda: estimate(gyr, acc, BENCH_FS, "wiener", {"scale_error": 0.005}, gyro_offset=False),
         "wiener_stationary": lambda: estimate(gyr, acc, BENCH_FS, "wiener", {"stationary": 1}, gyro_offset=False),
