@@ -2,7 +2,7 @@
 names, defaults, units, meanings and plausible ranges (blocks.params.Param).
 
 The C core's parameter header (af_params.h) is generated from it by the build
-(blocks/core/generate_tables.py), the FMUs' variables from it (fmu_src.variables), the
+(blocks/core/generate_tables.py), the FMUs' variables from it (systems.fmi.interface.variables), the
 command line's help from it; the methods (blocks.methods.registry) and stages
 (blocks.stages) take theirs from here. Only the standard library is imported, so that the
 build runs it without the package's dependencies.

@@ -6,7 +6,7 @@ same pipeline as `attitude estimate` (blocks.pipeline.online.OnlineEstimator). T
 parameters are those of every method and of the gyro-offset and heading estimators
 (blocks.pipeline.causal). Each starts at its default, so an importer shows the values the
 FMU runs with; one whose default is derived from others, or differs between the methods
-that share its name, starts at a value that means "unset" (fmu_src.variables.tuning_parameters;
+that share its name, starts at a value that means "unset" (systems.fmi.interface.variables.tuning_parameters;
 its description says what that means). Parameters of a method or estimator that does not run
 must stay at their start values. The choices (method, heading, gyro_offset, gyr_samples,
 acc_samples) are Enumerations, whose items the command line's choices spell.
@@ -18,7 +18,7 @@ import math
 from attitude_fmu.blocks.pipeline.causal import valid_sample
 from attitude_fmu.blocks.pipeline.online import OnlineEstimator, same_step
 from attitude_fmu.fmu_src.fmu_support import Fmi2Status, ProjectSlave
-from attitude_fmu.fmu_src.variables import attitude_estimator, tuning_parameters
+from attitude_fmu.systems.fmi.interface.variables import attitude_estimator, tuning_parameters
 
 
 def overrides(values) -> dict:

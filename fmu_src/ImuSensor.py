@@ -15,7 +15,7 @@ import numpy as np
 
 from attitude_fmu.blocks.stages.timing import same_step
 from attitude_fmu.fmu_src.fmu_support import ProjectSlave
-from attitude_fmu.fmu_src.simulation_variables import imu_sensor
+from attitude_fmu.systems.fmi.interface.simulation_variables import imu_sensor
 from attitude_fmu.systems.simulation.noise import MAGNETOMETER, SENSOR, NoiseStream
 from attitude_fmu.systems.simulation.sensor_model import ImuModel
 

@@ -8,7 +8,7 @@ the profiles' names.
 from __future__ import annotations
 
 from attitude_fmu.fmu_src.fmu_support import ProjectSlave
-from attitude_fmu.fmu_src.simulation_variables import motion_profile
+from attitude_fmu.systems.fmi.interface.simulation_variables import motion_profile
 from attitude_fmu.systems.simulation.motion import earth_field, profile
 
 

@@ -18,7 +18,8 @@ import numpy as np
 from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Real
 from pythonfmu.enums import Fmi2Status
 
-SYSTEM_FILE = "system.pickle"  # in the FMU's resources: (system, x0, dt)
+from attitude_fmu.systems.fmi.export.python import SYSTEM_FILE
+
 
 
 class PythonSystem(Fmi2Slave):

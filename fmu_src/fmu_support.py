@@ -1,6 +1,6 @@
 """FMI plumbing shared by the project's pythonfmu FMUs: registration of their variables from
-a table (fmu_src.variables) whose model description they write, FMU states, and the check
-that the attitude_fmu code a process runs is the FMU's own.
+a table (systems.fmi.interface.variables) whose model description they write, FMU states, and the check
+that the attitude_fmu code a process runs is the FMU's own (systems.fmi.carried_code).
 
 The models' equations live in `blocks/` and `systems/`; an FMU here only maps FMI
 variables onto them.
@@ -8,19 +8,16 @@ variables onto them.
 from __future__ import annotations
 
 import copy
-import hashlib
 import importlib
-import importlib.machinery
-import importlib.util
 import pickle
-import sys
-from pathlib import Path
 from xml.etree.ElementTree import Element
 
 from pythonfmu import Boolean, Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Integer, Real, String
 from pythonfmu.enums import Fmi2Status
 
-from attitude_fmu.fmu_src.model_description import (
+from attitude_fmu.systems.fmi.carried_code import foreign_code
+from attitude_fmu.systems.fmi.interface.escaping import xml_tree
+from attitude_fmu.systems.fmi.interface.model_description import (
     default_experiment,
     metadata,
     model_structure,
@@ -28,73 +25,9 @@ from attitude_fmu.fmu_src.model_description import (
     type_definitions,
     unit_definitions,
 )
-from attitude_fmu.fmu_src.variables import BOOLEAN, ENUMERATION, INTEGER, REAL, STRING, Table, item_name
+from attitude_fmu.systems.fmi.interface.variables import BOOLEAN, ENUMERATION, INTEGER, REAL, STRING, Table, item_name
 
-PACKAGE = "attitude_fmu"  # the modules of it an FMU imports are in its resources, under this name
 INTERNAL_STATE = " internal"  # key of a saved FMU state's model part (no variable name has a space)
-_file_digests: dict[Path, str] = {}  # source file → SHA-256 of its contents, taken the first time it is read
-
-
-def code_digest(root, files) -> str:
-    """SHA-256 over the files (paths relative to the folder root): their paths and contents;
-    a file root does not have counts as empty."""
-    root = Path(root)
-    digest = hashlib.sha256()
-    for relative in sorted(files):
-        digest.update(f"{relative}\0".encode())
-        path = root / relative
-        digest.update(path.read_bytes() if path.is_file() else b"\0missing")
-    return digest.hexdigest()
-
-
-def _file_digest(path: Path) -> str | None:
-    """The digest of a source file's contents, remembered: an importer may delete an FMU's
-    folder when it is done with it while its modules stay loaded. None: gone unread."""
-    if path not in _file_digests:
-        if not path.is_file():
-            return None
-        _file_digests[path] = hashlib.sha256(path.read_bytes()).hexdigest()
-    return _file_digests[path]
-
-
-def _origin(module: str) -> Path | None:
-    """The file this process runs a module from: the loaded one, else the one an import would load."""
-    loaded = sys.modules.get(module)
-    if loaded is not None:
-        return Path(loaded.__file__).resolve() if getattr(loaded, "__file__", None) else None
-    try:
-        spec = importlib.util.find_spec(module)
-    except ImportError:
-        return None
-    return Path(spec.origin).resolve() if spec is not None and spec.origin else None
-
-
-def foreign_code(resources) -> str | None:
-    """Why an FMU whose resources folder is resources cannot run in this process, or None.
-
-    An FMU carries the modules of attitude_fmu it imports (sources, and the extension
-    module's library), as packages without an __init__.py (namespace packages), so that
-    FMUs of one build loaded into one process (each carrying its own part) share one
-    package. Python keeps one copy of a module per process: if a module was imported from
-    other sources (an FMU of another build, an installed attitude_fmu of another version),
-    this FMU would run that code; it is refused instead."""
-    if resources is None:
-        return None
-    own_root = Path(resources) / PACKAGE
-    for path in sorted(own_root.rglob("*")):
-        suffix = next((s for s in (".py", *importlib.machinery.EXTENSION_SUFFIXES) if path.name.endswith(s)), None)
-        if suffix is None:
-            continue
-        module = ".".join((PACKAGE, *path.relative_to(own_root).parent.parts, path.name[: -len(suffix)]))
-        origin = _origin(module)
-        if origin is None or origin == path.resolve():
-            continue
-        theirs = _file_digest(origin)
-        if theirs is not None and theirs != _file_digest(path.resolve()):
-            return (f"this FMU's code differs from the attitude-fmu code this process imported before it ({module} "
-                    f"from {origin}); "
-                    "a process holds one copy of it: run FMUs of one build together, or each in a process of its own")
-    return None
 
 
 class ProjectSlave(Fmi2Slave):
@@ -166,7 +99,7 @@ class ProjectSlave(Fmi2Slave):
         root.insert(list(root).index(root.find("LogCategories")) + 1, default_experiment())
         root.append(model_variables(self.table))
         root.append(model_structure(self.table))
-        return root
+        return xml_tree(root, f"{type(self).__name__}'s modelDescription.xml")
 
     def item(self, name: str) -> str:
         """The item name of the Enumeration variable name's value (sets are checked: item_name
@@ -184,7 +117,7 @@ class ProjectSlave(Fmi2Slave):
         setattr(self, variable.name, value)
 
     def register(self, rows) -> None:
-        """Register rows of self.table (fmu_src.variables.Variable) with pythonfmu, each
+        """Register rows of self.table (systems.fmi.interface.variables.Variable) with pythonfmu, each
         held in the attribute of its name, which starts at its start value."""
         for v in rows:
             setattr(self, v.name, v.start)
@@ -198,7 +131,7 @@ class ProjectSlave(Fmi2Slave):
                 raise ValueError(f"{v.name}: pythonfmu numbers it otherwise than the table")
 
     def register_table(self, rows) -> None:
-        """Register every row of another table (an interface of fmu_src.variables)."""
+        """Register every row of another table (an interface of systems.fmi.interface.variables)."""
         self.register(self.table.extend_from(rows))
 
     error = None  # the message of an invalid configuration or of foreign code, once one was found

@@ -132,6 +132,10 @@ VALUE_CASES = [
     ("AttitudeEstimator", "heading", -1),
     ("AttitudeEstimator", "valid", 2),
     ("MotionProfile coning", "profile", 99),
+    ("MotionProfile human", "omega_x", NAN),  # outputs: a step leaves them as they were rather than not finite
+    ("MotionProfile coning", "omega_y", -INF),
+    ("AttitudeEstimator", "q_w", NAN),
+    ("ImuSensor", "acc_z", INF),
 ]
 # (configuration, header field, offset, format, value): the header's own fields
 HEADER_CASES = [
@@ -143,6 +147,9 @@ HEADER_CASES = [
     ("AttitudeEstimator", "guid", 57, "B", None),  # None: a hex digit other than the guid's own
     ("AttitudeEstimator", "size", 120, "Q", 1 << 40),
     ("AttitudeEstimator", "configuration", 128, "Q", 12345),
+    ("AttitudeEstimator", "time", 136, "d", NAN),
+    ("MotionProfile human", "time", 136, "d", INF),
+    ("ImuSensor", "time", 136, "d", -INF),
 ]
 
 
@@ -339,6 +346,23 @@ def test_a_state_with_a_header_field_out_of_its_range_is_refused(folder, layout,
     if value is None:
         value = ord("0") if valid[offset] != ord("0") else ord("1")
     assert_refused_and_unchanged(folder, config, forged(valid, info["header"], offset, fmt, value))
+
+
+@pytest.mark.parametrize("cells", [2**64 - 2, 2**63, 2**53 + 2])
+def test_a_human_motion_state_with_cells_beyond_its_grid_is_refused_though_its_times_agree(folder, layout, cells):
+    """Issue 50: a consistent forgery, the cells drawn near 2^64 (the count would wrap in the next step's
+    loop and never end) with the stream's time and the header's time those cells reach, is refused; a
+    stream draws 2^53 cells at most (human_motion.h, HUMAN_MAX_GRID)."""
+    info = layout["MotionProfile"]
+    donor = Instance(folder, "MotionProfile human")
+    valid = donor.serialised()
+    donor.free()
+    grid = struct.unpack_from("<d", valid, info["fields"]["stream.grid"][0])[0]
+    bad = valid
+    for field, fmt, value in (("stream.k", "Q", cells), ("stream.t", "d", cells * grid)):
+        bad = forged(bad, info["header"], info["fields"][field][0], fmt, value)
+    bad = forged(bad, info["header"], info["header"] + HEADER_TIME, "d", cells * grid)
+    assert_refused_and_unchanged(folder, "MotionProfile human", bad, reason="grid cells drawn")
 
 
 def test_a_state_cut_short_or_of_another_fmu_is_refused(folder, layout):

@@ -27,7 +27,7 @@ from fmpy.validation import validate_fmu
 
 from attitude_fmu.blocks.pipeline.online import OnlineEstimator
 from attitude_fmu.build_fmu import project_version
-from attitude_fmu.fmu_src import generate
+from attitude_fmu.systems.fmi.interface import generate
 from attitude_fmu.systems.cli.commands import build_parser
 from attitude_fmu.systems.fmi.cosim import FmuRunner, start_values
 from attitude_fmu.systems.simulation.motion import PROFILES

@@ -17,8 +17,8 @@ from fmpy.ssp.ssd import read_ssd
 from fmpy.validation import validate_fmu
 
 from attitude_fmu.blocks.methods.registry import METHODS
-from attitude_fmu.fmu_src.simulation_variables import motion_profile
-from attitude_fmu.fmu_src.variables import item_value
+from attitude_fmu.systems.fmi.interface.simulation_variables import motion_profile
+from attitude_fmu.systems.fmi.interface.variables import item_value
 from attitude_fmu.systems.fmi import stepping
 from attitude_fmu.systems.fmi import verify as verify_module
 from attitude_fmu.systems.fmi.cosim import (

@@ -26,7 +26,7 @@ from fmpy.validation import validate_fmu
 from attitude_fmu.blocks.methods.registry import METHODS
 from attitude_fmu.blocks.pipeline.causal import MAX_ACC_M_S2, MAX_GYR_RAD_S, valid_sample
 from attitude_fmu.blocks.pipeline.online import OnlineEstimator
-from attitude_fmu.fmu_src.variables import ENUMERATION, attitude_estimator
+from attitude_fmu.systems.fmi.interface.variables import ENUMERATION, attitude_estimator
 from attitude_fmu.systems.fmi import native
 from attitude_fmu.systems.fmi.build import build_fmus
 from attitude_fmu.systems.fmi.cosim import cosimulate_libcosim

@@ -19,8 +19,8 @@ from fmpy import extract, read_model_description
 from fmpy.fmi3 import FMU3Slave
 from lxml import etree
 
-from attitude_fmu.fmu_src.generate import MODELS
-from attitude_fmu.fmu_src.variables import ENUMERATION, item_value
+from attitude_fmu.systems.fmi.interface.generate import MODELS
+from attitude_fmu.systems.fmi.interface.variables import ENUMERATION, item_value
 from attitude_fmu.systems.cli.commands import EXIT_BAD_INPUT, main
 from attitude_fmu.systems.fmi.cosim import FmuRunner, cosimulate, cosimulate_libcosim
 from attitude_fmu.systems.fmi.ssp import COMPONENTS, CONNECTIONS, write_ssp
@@ -119,7 +119,7 @@ def test_every_connector_and_binding_names_a_variable_of_its_fmu_with_the_matchi
 def test_no_string_binding_and_the_choices_as_the_integers_of_their_items(packages, chain):
     """Every binding is Real, Integer or Boolean (libcosim and OMSimulator read no other
     together: OMSimulator no String, libcosim no Enumeration); each choice as its item's value in
-    the project's tables (fmu_src.variables.item_value)."""
+    the project's tables (systems.fmi.interface.variables.item_value)."""
     ssd = _ssd(packages[chain])
     bound = {}
     for component in ssd.iterfind("ssd:System/ssd:Elements/ssd:Component", NS):

@@ -59,9 +59,15 @@ def stages() -> list[tuple[str, str, str, tuple[Param, ...]]]:
 
 
 def c_string(text: str) -> str:
-    """text as a C string literal: UTF-8, bytes outside printable ASCII as octal escapes."""
+    """text as a C string literal: UTF-8, bytes outside printable ASCII as octal escapes; ValueError
+    for a lone surrogate, which UTF-8 cannot hold."""
     out = []
-    for byte in text.encode("utf-8"):
+    try:
+        data = text.encode("utf-8")
+    except UnicodeEncodeError as exc:
+        raise ValueError(f"{text[:80]!r} holds the lone surrogate U+{ord(text[exc.start]):04X}, which UTF-8 cannot "
+                         f"hold") from None
+    for byte in data:
         char = chr(byte)
         if char in '\\"?':
             out.append("\\" + char)

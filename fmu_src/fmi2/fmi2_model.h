@@ -7,7 +7,7 @@
  * variable's causality and variability forbid: fmi2Error with a log message), saves and
  * serialises FMU states, and logs through the importer's callback. A model file (models/<Name>.c)
  * defines `fmi2_model`: its variables (a table generated from the project's table of FMU
- * variables, fmu_src/variables.py, into <Name>_variables.h), the size of its own state and three
+ * variables, systems/fmi/interface/variables.py, into <Name>_variables.h), the size of its own state and three
  * functions: called at fmi2ExitInitializationMode, at each fmi2DoStep, and on an FMU state before
  * fmi2SetFMUstate or fmi2DeSerializeFMUstate takes it (fmi2/fmu_state.h). */
 #ifndef FMI2_MODEL_H

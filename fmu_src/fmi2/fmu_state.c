@@ -1,6 +1,7 @@
 /* fmu_state.c: FMU states and their serialisation (fmu_state.h). */
 #include "fmu_state.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -68,6 +69,10 @@ static const char *values_refusal(const Fmi2Instance *view) {
         case FMI2_STRING:
             if (!memchr(view->strings[v->index], '\0', FMI2_STRING_SIZE)) return "a String's value has no end";
             break;
+        case FMI2_REAL: /* the models' steps leave their outputs as they were rather than not finite */
+            if (v->causality == FMI2_OUTPUT && !isfinite(view->reals[v->index]))
+                return "an output's value is not finite";
+            break;
         default: break;
         }
     }
@@ -124,6 +129,7 @@ static int state_check(const State *s, const Fmi2Instance *configured, char *rea
         why = "an FMU state of another FMU (guid)";
     else if (h->size != view.data_size) why = "an FMU state of another size";
     else if (h->phase < 0 || h->phase >= FMI2_N_PHASES) why = "an FMU state in no known state";
+    else if (!isfinite(h->time)) why = "an FMU state whose time is not finite";
     else if (h->check != fmi2_state_checksum(s->data, view.data_size))
         why = "an FMU state whose data changed (checksum)";
     else why = values_refusal(&view); /* before the configuration: its hash reads the values */

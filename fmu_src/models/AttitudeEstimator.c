@@ -1,5 +1,5 @@
 /* AttitudeEstimator.c: the model of the native AttitudeEstimator.fmu: its variables
- * (AttitudeEstimator_variables.h, generated from fmu_src/variables.py) onto the C core's online
+ * (AttitudeEstimator_variables.h, generated from systems/fmi/interface/variables.py) onto the C core's online
  * estimator (core/pipeline/online.h).
  * fmu_src/AttitudeEstimator.py is the pythonfmu model of the same variables (the same checks,
  * messages and statuses). */

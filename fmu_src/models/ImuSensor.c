@@ -1,5 +1,5 @@
 /* ImuSensor.c: the model of the native ImuSensor.fmu: its variables (ImuSensor_variables.h,
- * generated from fmu_src/simulation_variables.py) onto the simulation's sensor model (sensor.h),
+ * generated from systems/fmi/interface/simulation_variables.py) onto the simulation's sensor model (sensor.h),
  * delay line (delay_line.h) and noise streams (noise.h): step k draws sample k of the
  * streams SENSOR and MAGNETOMETER of `seed`, as ImuModel.apply and apply_mag draw them.
  * The pythonfmu ImuSensor (fmu_src/ImuSensor.py) runs the same C core with the same checks,

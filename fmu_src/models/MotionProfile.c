@@ -1,5 +1,5 @@
 /* MotionProfile.c: the model of the native MotionProfile.fmu: its variables (MotionProfile_variables.h,
- * generated from fmu_src/simulation_variables.py) onto the simulation's motions: the human motion's
+ * generated from systems/fmi/interface/simulation_variables.py) onto the simulation's motions: the human motion's
  * stream on its grid (human_motion.h) and the closed forms (closed_form.h), both functions of time
  * alone. doStep(t, h) outputs the interval (t, t+h]: the rate that turns the orientation over it, the
  * specific force of its mean acceleration, field and orientation at t+h. A profile's parameters are the

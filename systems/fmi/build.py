@@ -8,7 +8,7 @@ Each pythonfmu FMU carries in its resources the modules of attitude_fmu that its
 adapter imports (carried_files), the compiled extension attitude_fmu._core among them, so it
 runs where only numpy, scipy, control and pythonfmu are installed, and carries no command
 line, plots, benchmarks or build code; its packages have no __init__.py there, so that FMUs
-of one build share them (fmu_support.foreign_code).
+of one build share them (carried_code.foreign_code).
 
 On Linux (and macOS, not yet tried there) the FMU's binary is fmu_src/fmi2_guard.c as the
 package's build made it (built/fmi2_guard.so); it loads pythonfmu's library from beside it and
@@ -32,8 +32,8 @@ from pathlib import Path
 
 import attitude_fmu
 from attitude_fmu.build_fmu import project_version
-from attitude_fmu.fmu_src.documentation import write_documentation
-from attitude_fmu.fmu_src.fmu_support import PACKAGE, code_digest
+from attitude_fmu.systems.fmi.interface.documentation import write_documentation
+from attitude_fmu.systems.fmi.carried_code import PACKAGE, code_digest
 from attitude_fmu.systems.fmi import fmi3, platforms as cross
 from attitude_fmu.systems.fmi.native import NATIVE_NAMES, NotBuilt, built, copy_fmus, is_current
 
@@ -84,6 +84,18 @@ def _imports(path: Path, module: str) -> set[str]:
             for alias in node.names:
                 found.add(f"{base}.{alias.name}" if _module_file(f"{base}.{alias.name}") else base)
     return found
+
+
+def adapter_description(name: str) -> str:
+    """The description of the adapter fmu_src/<name>.py's class name (its `description = ...`, a string
+    literal), read without importing it."""
+    tree = ast.parse((SOURCE_DIR / f"{name}.py").read_text(encoding="utf-8"))
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ClassDef) and node.name == name:
+            for item in node.body:
+                if isinstance(item, ast.Assign) and [ast.unparse(t) for t in item.targets] == ["description"]:
+                    return ast.literal_eval(item.value)
+    raise ValueError(f"fmu_src/{name}.py: class {name} states no description")
 
 
 def carried_files(name: str) -> list[str]:
@@ -159,12 +171,13 @@ def build_fmus(out, names=FMU_NAMES, native=NATIVE_NAMES, fmi3_names=fmi3.FMI3_N
     guard = guard_binary() if names else None
     with tempfile.TemporaryDirectory(prefix="attitude_fmu_") as tmp:
         for name in names:
-            # only what the adapter imports, as namespace packages (fmu_support.foreign_code)
+            # only what the adapter imports, as namespace packages (carried_code.foreign_code)
             staged = Path(tmp) / name / PACKAGE
             for relative in (f for f in carried_files(name) if not f.endswith("__init__.py")):
                 (staged / relative).parent.mkdir(parents=True, exist_ok=True)
                 shutil.copy2(PACKAGE_DIR / relative, staged / relative)
-            documentation = write_documentation(Path(tmp) / name / "documentation", name, project_version())
+            documentation = write_documentation(Path(tmp) / name / "documentation", name, adapter_description(name),
+                                                project_version())
             built_fmus.append(Path(FmuBuilder.build_FMU(SOURCE_DIR / f"{name}.py", dest=out, project_files=[staged],
                                                         documentation_folder=documentation,
                                                         needsExecutionTool="false", canGetAndSetFMUstate="true",

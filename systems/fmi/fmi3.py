@@ -4,7 +4,7 @@ ImuSensor and MotionProfile (systems.fmi.native), which build_fmus copies into D
 Each has the same model file and C core as its FMI 2.0 FMU, on the FMI 3.0 entry points of fmu_src/fmi3
 (which run the plumbing's instances, values and FMU states of fmu_src/fmi2), built against the
 fmi3 headers fmpy installs. Its modelDescription.xml is written from the same table of FMU
-variables (fmu_src.model_description.model_description3): Real as Float64, Integer as Int32,
+variables (systems.fmi.interface.model_description.model_description3): Real as Float64, Integer as Int32,
 Enumerations as FMI 3.0 Enumerations (set and got as Int64), Boolean as itself, with the same names, value references, causalities, units
 and start values, and `time`, FMI 3.0's independent variable, after them. The instantiation
 token is a digest of everything the FMU is built from (is_current).

@@ -13,8 +13,8 @@ the package's folder, in BUILT:
 
 Each FMU carries its sources (sources/, generated headers and buildDescription.xml included),
 so that an importer on another platform builds it (`fmpy compile`); its modelDescription.xml
-and variables header are written from the table of FMU variables (fmu_src/variables.py) by
-fmu_src/generate.py, so it and the pythonfmu FMU of the same interface can take each other's
+and variables header are written from the table of FMU variables (systems/fmi/interface/variables.py) by
+systems/fmi/interface/generate.py, so it and the pythonfmu FMU of the same interface can take each other's
 place. Its guid is a digest of everything it is built from: an FMU built from other sources
 is told apart (is_current). `pip install` builds and installs them all; in a clone,
 `python build_fmu.py` (or `cmake --install BUILD_FOLDER --prefix .`) puts them into it.

@@ -6,7 +6,7 @@ signals, where asked.
 
 The SSD is valid against the SSP 1.0 schema and holds only what both OMSimulator and libcosim
 read: connectors of type Real or Boolean, parameter values of type Real, Integer or Boolean
-(an Enumeration parameter as its item's Integer value, fmu_src.variables.item_value), and the
+(an Enumeration parameter as its item's Integer value, systems.fmi.interface.variables.item_value), and the
 communication step in each one's annotation where the schema allows annotations: OMSimulator's
 fixed-step master (org.openmodelica, as its SSP import and its Python API read it) in the System,
 libcosim's fixed-step algorithm (com.opensimulationplatform) in the DefaultExperiment.
@@ -18,8 +18,8 @@ import zipfile
 from pathlib import Path
 from xml.etree.ElementTree import Element, SubElement, register_namespace, tostring
 
-from attitude_fmu.fmu_src.generate import MODELS
-from attitude_fmu.fmu_src.variables import BOOLEAN, ENUMERATION, IN, INTEGER, OUT, PAR, REAL, item_value
+from attitude_fmu.systems.fmi.interface.generate import MODELS
+from attitude_fmu.systems.fmi.interface.variables import BOOLEAN, ENUMERATION, IN, INTEGER, OUT, PAR, REAL, item_value
 from attitude_fmu.systems.fmi.fmi3 import FOLDER as FMI3_FOLDER
 
 SSD = "http://ssp-standard.org/SSP1/SystemStructureDescription"
@@ -37,7 +37,7 @@ IDENT = re.compile(r"[A-Za-z][A-Za-z0-9_-]*")  # OMSimulator's names of models (
 
 
 def _interface(fmu: str) -> tuple[str, list[str], list[str]]:
-    """(FMU, its inputs, its outputs) from its table of variables (fmu_src.generate.MODELS)."""
+    """(FMU, its inputs, its outputs) from its table of variables (systems.fmi.interface.generate.MODELS)."""
     table = MODELS[fmu].interface()
     return fmu, [v.name for v in table if v.causality == IN], [v.name for v in table if v.causality == OUT]
 

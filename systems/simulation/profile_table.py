@@ -1,6 +1,6 @@
 """The motion profiles' names, summaries and parameters (blocks.params.Param), in one table:
 the source of systems.simulation.motion's profiles and of MotionProfile.fmu's variables
-(fmu_src.simulation_variables). Only the standard library is imported, so that the build
+(systems.fmi.interface.simulation_variables). Only the standard library is imported, so that the build
 writes the FMU's model description without the package's dependencies."""
 from __future__ import annotations
 

@@ -9,15 +9,21 @@ from pathlib import Path
 import numpy as np
 
 from attitude_fmu.systems.fmi.export.flatten import ExportError, flatten
+from attitude_fmu.systems.fmi.interface.escaping import c_identifier, fmi_name, xml_text
 
 BACKENDS = ("native", "python")
 
 
+NAME_MAX = 200  # characters of a model identifier: its files' names (NAME_variables.h, NAME.dll) stay below 255 bytes
+
+
 def _model_name(system, name: str | None) -> str:
-    """The FMU's model identifier: name, or the system's name; ValueError unless a C identifier."""
-    name = name if name is not None else system.name
-    if not (isinstance(name, str) and name.isidentifier() and name.isascii()):
-        raise ValueError(f"the FMU's name (model identifier) must be a C identifier, got {name!r}: give name=")
+    """The FMU's model identifier: name, or the system's name; ValueError unless a C identifier (no
+    keyword) of NAME_MAX characters at most."""
+    name = c_identifier(name if name is not None else system.name, "the FMU's name (model identifier; give name=)")
+    if len(name) > NAME_MAX:
+        raise ValueError(f"the FMU's name (model identifier) has {len(name)} characters; its files' names take "
+                         f"{NAME_MAX} at most: give a shorter name=")
     return name
 
 
@@ -45,7 +51,10 @@ def export_fmu(system, path, *, x0=None, step: float | None = None, fmi_version:
     runs); cmake_options: more -D options of the native build (NAME=VALUE: AF_WERROR=ON, warnings as
     errors; AF_SANITIZE=ON, the address and undefined-behaviour sanitizers); log: progress messages.
     ExportError names a block that cannot be exported natively (a Python-function block, an
-    algebraic loop) and why; ValueError for bad arguments."""
+    algebraic loop) and why; ValueError for bad arguments and for names that cannot go into the FMU's
+    files as they are (systems.fmi.interface.escaping): a signal label outside FMI's structured naming
+    (a<b: rename it, or quote it, 'a<b'), a name that is no C identifier. Every other text (the
+    system's and blocks' names) is escaped where it goes: C string literals, XML, Python literals."""
     from attitude_fmu.systems.fmi.platforms import parse_platforms
 
     if backend not in BACKENDS:
@@ -53,6 +62,9 @@ def export_fmu(system, path, *, x0=None, step: float | None = None, fmi_version:
     if fmi_version not in ("2.0", "3.0"):
         raise ValueError(f"fmi_version must be '2.0' or '3.0', got {fmi_version!r}")
     model = _model_name(system, name)
+    xml_text(str(system.name), "the system's name")
+    for label in (*getattr(system, "input_labels", ()), *getattr(system, "output_labels", ())):
+        fmi_name(label)
     path = Path(path)
     if path.suffix != ".fmu":
         raise ValueError(f"the FMU's path must end in .fmu, got {str(path)!r}")

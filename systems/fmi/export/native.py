@@ -44,11 +44,11 @@ def source_files(fmi: str) -> dict[str, bytes]:
 
 
 def stage_files(name: str, fmi: str, diagram, x0, step: float | None, description: str) -> dict[str, bytes]:
-    """The FMU's files but its binaries, by their path in it (fmu_src/generate.py's generated_files over
+    """The FMU's files but its binaries, by their path in it (systems/fmi/interface/generate.py's generated_files over
     the diagram's variables and tables)."""
     from attitude_fmu.build_fmu import project_version
-    from attitude_fmu.fmu_src.documentation import EXPORTED
-    from attitude_fmu.fmu_src.generate import NativeModel, generated_files
+    from attitude_fmu.systems.fmi.interface.documentation import EXPORTED
+    from attitude_fmu.systems.fmi.interface.generate import NativeModel, generated_files
     from attitude_fmu.systems.fmi.export.tables import tables_header, variables
 
     table, first = variables(diagram, fmi)
@@ -89,7 +89,7 @@ def write_native(path: Path, name: str, fmi: str, diagram, x0, step, description
                  log=lambda message: None) -> Path:
     """The native FMU of the diagram written to path, with the binaries of this platform and the platforms
     (FMI 3.0 tuples; FMI 2.0: those with an FMI 2.0 folder), each built with the -D options."""
-    from attitude_fmu.fmu_src.generate import write_stage
+    from attitude_fmu.systems.fmi.interface.generate import write_stage
     from attitude_fmu.systems.fmi.platforms import LIBRARY_SUFFIXES, PLATFORMS
 
     with tempfile.TemporaryDirectory(prefix="attitude_fmu_export_") as tmp:

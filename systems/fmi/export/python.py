@@ -7,13 +7,24 @@ from pathlib import Path
 
 import numpy as np
 
+from attitude_fmu.systems.fmi.interface.escaping import python_identifier, python_literal
+
+SYSTEM_FILE = "system.pickle"  # in the FMU's resources: (system, x0, dt), which fmu_src/PythonSystem.py loads
+
+
+def script_text(name: str, title: str) -> str:
+    """The pythonfmu script of the model name (a Python identifier, no keyword): class name, a PythonSystem,
+    whose docstring names the system title (any text: a Python string literal, escaping.python_literal)."""
+    return (f"from attitude_fmu.fmu_src.PythonSystem import PythonSystem\n\n\n"
+            f"class {python_identifier(name, 'the model identifier')}(PythonSystem):\n"
+            f"    {python_literal(f'python-control system {title}, exported by attitude_fmu.')}\n")
+
 
 def write_python(path: Path, name: str, system, x0, step, fmi_version: str) -> Path:
     """The pythonfmu FMU name of the discrete system (initial state x0, None: zeros) written to path."""
     import cloudpickle
     from pythonfmu.builder import FmuBuilder
 
-    from attitude_fmu.fmu_src.PythonSystem import SYSTEM_FILE
     from attitude_fmu.systems.fmi.build import guard_binary, guarded
 
     if fmi_version != "2.0":
@@ -26,10 +37,7 @@ def write_python(path: Path, name: str, system, x0, step, fmi_version: str) -> P
     x0 = np.zeros(system.nstates) if x0 is None else np.asarray(x0, dtype=float)
     with tempfile.TemporaryDirectory(prefix="attitude_fmu_export_") as tmp:
         script = Path(tmp) / f"{name}.py"
-        script.write_text(f"from attitude_fmu.fmu_src.PythonSystem import PythonSystem\n\n\n"
-                          f"class {name}(PythonSystem):\n"
-                          f"    \"\"\"python-control system {system.name}, exported by attitude_fmu.\"\"\"\n",
-                          encoding="utf-8")
+        script.write_text(script_text(name, system.name), encoding="utf-8")
         (Path(tmp) / SYSTEM_FILE).write_bytes(cloudpickle.dumps((system, x0, float(dt))))
         built = FmuBuilder.build_FMU(script, dest=Path(tmp) / "out", project_files=[Path(tmp) / SYSTEM_FILE],
                                      needsExecutionTool="false", canGetAndSetFMUstate="true",

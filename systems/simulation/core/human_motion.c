@@ -84,6 +84,9 @@ int human_stream_step(HumanStream *s, double start, double end, double out[HUMAN
     if (!(isfinite(start) && isfinite(end) && start <= end && start >= s->t - 1e-9 * fmax(1.0, s->t)))
         return refuse(message, size, "the human motion steps forward from time 0 s: not over (%s, %s] s after %s s",
                       float_repr(start, a), float_repr(end, b), float_repr(s->t, c));
+    if (ceil(end / G) > HUMAN_MAX_GRID)
+        return refuse(message, size, "a step to %s s ends beyond the human motion's grid (%.0f cells of %s s)",
+                      float_repr(end, a), HUMAN_MAX_GRID, float_repr(G, b));
     if (ceil(end / G) - (double)s->k > HUMAN_MAX_CELLS)
         return refuse(message, size, "a step to %s s needs more than %.0f cells of the human motion's grid (%s s)",
                       float_repr(end, a), HUMAN_MAX_CELLS, float_repr(G, b));
@@ -143,6 +146,9 @@ int human_stream_validate(const HumanStream *s, const HumanStream *configured, c
     double G = s->grid, cells = (double)s->k;
     if (!(isfinite(s->t) && s->t >= 0.0))
         return refuse(message, size, "the human motion's time is not a finite time from 0 s");
+    if (cells > HUMAN_MAX_GRID)
+        return refuse(message, size, "the human motion's grid cells drawn (%.0f) are more than it draws (%.0f)", cells,
+                      HUMAN_MAX_GRID);
     if (!(cells * G >= s->t * (1.0 - 1e-12) && (cells - 1.0) * G <= s->t + G * (1.0 + 1e-12)) ||
         (s->k == 0 && s->t != 0.0))
         return refuse(message, size, "the human motion's grid cells drawn (%.0f) are not those that reach its time",

@@ -16,6 +16,8 @@
 #define HUMAN_N_COEF 9    /* phi_v, sig_v, phi_w, sig_w, Ts (s), g (m/s^2), lever (m, 3) */
 #define HUMAN_N_OUT 10    /* omega (rad/s, 3), specific force (m/s^2, 3), q (4) */
 #define HUMAN_MAX_CELLS 4194304.0 /* grid cells one step may draw (about 2 s of work; 70 min of the default grid) */
+#define HUMAN_MAX_GRID 9007199254740992.0 /* grid cells a stream draws in all (2^53: counts and times stay exact and
+                                           * the 64-bit count far from wrapping) */
 
 /* delta_v: density of the velocity, m/s/sqrt(Hz); omega_c: its band limit, rad/s; rot_rms: RMS
  * angular rate per axis, rad/s; rot_cutoff: its band limit, rad/s; g: gravity, m/s^2; lever: the sensor's
@@ -55,15 +57,15 @@ void human_stream_init(HumanStream *stream, const HumanParams *params, double gr
  * out the rate that turns q(start) into q(end) over it (the rotation vector over end - start), the
  * specific force R(end)^T (mean acceleration over it + g z) and q(end); where end - start rounds to 0,
  * the rate and acceleration at start. 0, or -1 with the refusal (an interval that is not finite,
- * starts before the last one ends, or needs more than HUMAN_MAX_CELLS grid cells) and the stream as
- * it was. */
+ * starts before the last one ends, needs more than HUMAN_MAX_CELLS grid cells or ends beyond
+ * HUMAN_MAX_GRID of them) and the stream as it was. */
 int human_stream_step(HumanStream *stream, double start, double end, double out[HUMAN_N_OUT], char *message,
                       size_t size);
 
 /* Whether s (bytes nobody vouches for, e.g. an FMU state's) is a stream human_stream_init made as it made
  * configured, stepped on: its parameters, seed, grid and coefficients configured's, its time t finite and
- * not negative, its cells drawn those that reach t, its states finite, its quaternions unit ones. 0, or -1
- * with a message. */
+ * not negative, its cells drawn those that reach t and HUMAN_MAX_GRID at most, its states finite, its
+ * quaternions unit ones. 0, or -1 with a message. */
 int human_stream_validate(const HumanStream *s, const HumanStream *configured, char *message, size_t size);
 
 #endif

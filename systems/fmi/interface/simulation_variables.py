@@ -1,13 +1,13 @@
 """The interfaces of the simulation's FMUs, ImuSensor and MotionProfile: tables of FMU variables
-(fmu_src.variables.Table), from which the pythonfmu FMU registers its variables and the native
-one's modelDescription.xml and C header are written (fmu_src/generate.py, by the build), so one
+(systems.fmi.interface.variables.Table), from which the pythonfmu FMU registers its variables and the native
+one's modelDescription.xml and C header are written (systems/fmi/interface/generate.py, by the build), so one
 can take the other's place in an SSP. fmu_src/ImuSensor.py and fmu_src/MotionProfile.py say what
 each step does. Only the standard library is imported (and systems/simulation/profile_table.py)."""
 from __future__ import annotations
 
 from functools import cache
 
-from attitude_fmu.fmu_src.variables import IN, INTEGER, OUT, PAR, Table, Variable, fmi_unit
+from attitude_fmu.systems.fmi.interface.variables import IN, INTEGER, OUT, PAR, Table, Variable, fmi_unit
 from attitude_fmu.systems.simulation.profile_table import EARTH_FIELD_UT, PROFILES
 
 

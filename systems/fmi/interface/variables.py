@@ -2,9 +2,9 @@
 variability, initial, unit, start value, description, value reference).
 
 Every model description of an interface is written from its table
-(fmu_src.model_description): the pythonfmu FMU registers its variables from it
+(systems.fmi.interface.model_description): the pythonfmu FMU registers its variables from it
 (fmu_support.ProjectSlave), the native FMU's modelDescription.xml and C header are
-generated from it by the build (fmu_src/generate.py). So one FMU can take the other's place
+generated from it by the build (systems/fmi/interface/generate.py). So one FMU can take the other's place
 in an SSP or a master's script: same names, causalities, units, start values and value
 references. Only the standard library is imported (and blocks/tuning.py): the build runs it.
 """
@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from functools import cache
 
 from attitude_fmu.blocks.tuning import METHODS, uses
+from attitude_fmu.systems.fmi.interface.escaping import fmi_name
 
 # the sample conventions, as blocks.stages.timing (the C core's stages/timing.c) lists them
 GYR_SAMPLES, ACC_SAMPLES = ("mean", "point"), ("point", "mean")
@@ -53,7 +54,7 @@ def fmi_unit(unit: str) -> str:
     """The FMI unit name of a unit as the project documents it ("m/s²" → "m/s2", "√Hz" → "sqrt(Hz)")."""
     name = unit.replace("√Hz", "sqrt(Hz)").replace("²", "2")
     if name not in UNITS:
-        raise ValueError(f"unit {unit!r} has no FMI definition in fmu_src.variables.UNITS")
+        raise ValueError(f"unit {unit!r} has no FMI definition in systems.fmi.interface.variables.UNITS")
     return name
 
 
@@ -129,9 +130,11 @@ class Table(list):
 
     def add(self, name, type_, causality, variability, start, description, unit=None, initial=None,
             items=(), dimensions=()) -> list[Variable]:
-        """A row; its value reference the next free one (an array holds one per element)."""
+        """A row; its value reference the next free one (an array holds one per element). ValueError
+        for a name outside FMI's structured naming (escaping.fmi_name)."""
+        fmi_name(name)
         if unit is not None and unit not in UNITS:
-            raise ValueError(f"unit {unit!r} has no definition in fmu_src.variables.UNITS")
+            raise ValueError(f"unit {unit!r} has no definition in systems.fmi.interface.variables.UNITS")
         if dimensions and (type_ != REAL or len(start) != math.prod(dimensions)):
             raise ValueError(f"{name}: an array is a Real with a start value per element")
         self.append(Variable(name, type_, causality, variability, start, description,

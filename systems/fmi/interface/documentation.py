@@ -1,5 +1,5 @@
 """The documentation/ folder of an FMU (FMI 2.0 and 3.0 alike): index.html, which lists the
-variables of the FMU's table (fmu_src.variables) with their units, causalities and start
+variables of the FMU's table (systems.fmi.interface.variables) with their units, causalities and start
 values and says when the inputs are taken and the outputs hold, and licenses/LICENSE, the
 project's license. Only the standard library is imported: the build runs it."""
 from __future__ import annotations
@@ -7,10 +7,10 @@ from __future__ import annotations
 from html import escape
 from pathlib import Path
 
-from attitude_fmu.fmu_src.model_description import COPYRIGHT, start_text
-from attitude_fmu.fmu_src.variables import DISPLAY_UNITS, ENUMERATION, IN, OUT
+from attitude_fmu.systems.fmi.interface.model_description import COPYRIGHT, start_text
+from attitude_fmu.systems.fmi.interface.variables import DISPLAY_UNITS, ENUMERATION, IN, OUT
 
-LICENSE_FILE = Path(__file__).resolve().parents[1] / "LICENSE"  # the project's
+LICENSE_FILE = Path(__file__).resolve().parents[3] / "LICENSE"  # the project's
 
 # the time convention of every step: sample k of a stream is the one whose interval (t[k], t[k+1]] the
 # step doStep(t[k], t[k+1] - t[k]) covers
@@ -92,15 +92,12 @@ def documentation_files(name: str, description: str, fmi: str, version: str, var
             "documentation/licenses/LICENSE": LICENSE_FILE.read_bytes()}
 
 
-def write_documentation(folder, name: str, version: str) -> Path:
+def write_documentation(folder, name: str, description: str, version: str) -> Path:
     """The documentation/ files of the pythonfmu FMU name (fmu_src/<name>.py: AttitudeEstimator,
-    ImuSensor, MotionProfile) written into folder, for pythonfmu's
+    ImuSensor, MotionProfile) with its description written into folder, for pythonfmu's
     FmuBuilder.build_FMU(documentation_folder=folder); returns folder."""
-    from importlib import import_module
+    from attitude_fmu.systems.fmi.interface.generate import MODELS  # the interfaces, which the native FMUs share
 
-    from attitude_fmu.fmu_src.generate import MODELS  # the interfaces, which the native FMUs share
-
-    description = getattr(import_module(f"attitude_fmu.fmu_src.{name}"), name).description
     folder = Path(folder)
     for path, data in documentation_files(name, description, "2.0", version, MODELS[name].interface()).items():
         target = folder / Path(path).relative_to("documentation")

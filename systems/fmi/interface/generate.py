@@ -1,18 +1,18 @@
 """The generated files of a native FMU, written by the build (CMakeLists.txt, af_fmu) into the
 FMU's staging folder, beside its sources:
 
-    python fmu_src/generate.py NAME FMI STAGE VERSION DEST=SOURCE...
+    python systems/fmi/interface/generate.py NAME FMI STAGE VERSION DEST=SOURCE...
 
 NAME is a model of MODELS (its C model file, NAME.c in fmu_src/models), FMI "2.0" or "3.0",
 VERSION the project's (the generation tool's), each DEST=SOURCE a source file and its path
 under the FMU's sources/ folder (as the files include each other: that folder is the one
 include directory, as `fmpy compile` builds it). Writes into STAGE:
 
-    modelDescription.xml              from the table of FMU variables (fmu_src/variables.py)
+    modelDescription.xml              from the table of FMU variables (systems/fmi/interface/variables.py)
     sources/DEST...                   the sources, copied
     sources/NAME_variables.h          the variables as the plumbing takes them (fmi2/fmi2_model.h)
     sources/buildDescription.xml      every C file and header, for importers that build the FMU themselves
-    documentation/index.html          the variables and the time convention (fmu_src/documentation.py)
+    documentation/index.html          the variables and the time convention (systems/fmi/interface/documentation.py)
     documentation/licenses/LICENSE    the project's license
 
 The generation time in modelDescription.xml is SOURCE_DATE_EPOCH's where the environment sets it.
@@ -33,23 +33,23 @@ from pathlib import Path
 from xml.etree.ElementTree import Element, SubElement, tostring
 
 if __package__ in (None, ""):  # run as a script by the build: this clone's folder as attitude_fmu
-    _root = Path(__file__).resolve().parents[1]
+    _root = Path(__file__).resolve().parents[3]
     _spec = importlib.util.spec_from_file_location("attitude_fmu", _root / "__init__.py",
                                                    submodule_search_locations=[str(_root)])
     sys.modules["attitude_fmu"] = importlib.util.module_from_spec(_spec)
     _spec.loader.exec_module(sys.modules["attitude_fmu"])
 
-from attitude_fmu.blocks.core.generate_tables import c_double, c_string  # noqa: E402
-from attitude_fmu.fmu_src.documentation import documentation_files  # noqa: E402
-from attitude_fmu.fmu_src.model_description import (  # noqa: E402
+from attitude_fmu.systems.fmi.interface.documentation import documentation_files  # noqa: E402
+from attitude_fmu.systems.fmi.interface.escaping import c_double, c_identifier, c_string, xml_tree  # noqa: E402
+from attitude_fmu.systems.fmi.interface.model_description import (  # noqa: E402
     LOG_CATEGORIES,
     model_description,
     model_description3,
     model_variables,
     model_variables3,
 )
-from attitude_fmu.fmu_src.simulation_variables import imu_sensor, motion_profile  # noqa: E402
-from attitude_fmu.fmu_src.variables import (  # noqa: E402
+from attitude_fmu.systems.fmi.interface.simulation_variables import imu_sensor, motion_profile  # noqa: E402
+from attitude_fmu.systems.fmi.interface.variables import (  # noqa: E402
     BOOLEAN,
     ENUMERATION,
     INTEGER,
@@ -66,7 +66,7 @@ GUID_NAMESPACE = uuid.UUID("6f0e2a4c-8b1d-4c55-9d3e-2f7a1b9c0d41")  # of the nat
 
 @dataclass(frozen=True)
 class NativeModel:
-    """A native FMU's interface (a table of fmu_src.variables), description and, where it is not
+    """A native FMU's interface (a table of systems.fmi.interface.variables), description and, where it is not
     documentation.CONVENTIONS', its time convention."""
 
     interface: object
@@ -95,12 +95,6 @@ def _initial(v) -> str:
     return "FMI2_CALCULATED" if v.causality == OUT else "FMI2_INITIAL_UNSET"
 
 
-def _identifier(name: str) -> str:
-    if not (name.isidentifier() and name.isascii()):
-        raise ValueError(f"variable name {name!r} is not a C identifier")
-    return name
-
-
 def variables_header(name: str, guid: str, model: NativeModel | None = None) -> str:
     """The text of <name>_variables.h: the model's variables (model, default MODELS[name]) as the
     plumbing takes them (fmi2/fmi2_model.h: Fmi2Variable, by value reference; an FMI 3.0 array as
@@ -117,7 +111,7 @@ def variables_header(name: str, guid: str, model: NativeModel | None = None) -> 
     scalars = [(v, k, element, start) for v in variables for k, (element, start) in enumerate(v.elements())]
     lines, items, counts = [], [], dict.fromkeys((REAL, INTEGER, BOOLEAN, STRING), 0)
     for type_ in counts:
-        names = [_identifier(v.name) if indexed else v.name for v, *_ in scalars if HELD_AS[v.type] == type_]
+        names = [c_identifier(v.name, 'a variable name') if indexed else v.name for v, *_ in scalars if HELD_AS[v.type] == type_]
         if names and indexed:
             lines += ["enum {", *(f"    {type_.upper()}_{n} = {i}," for i, n in enumerate(names)), "};"]
         lines.append(f"#define N_{type_.upper()}S {len(names)}")
@@ -136,8 +130,8 @@ def variables_header(name: str, guid: str, model: NativeModel | None = None) -> 
                     f"/* {v.value_reference + k} */")
     guard = f"{name.upper()}_VARIABLES_H"
     return "\n".join([
-        f"/* {name}_variables.h: the variables of {name}.fmu, generated by fmu_src/generate.py from the",
-        " * table of FMU variables (fmu_src/variables.py) that writes its modelDescription.xml.",
+        f"/* {name}_variables.h: the variables of {name}.fmu, generated by systems/fmi/interface/generate.py from the",
+        " * table of FMU variables (systems/fmi/interface/variables.py) that writes its modelDescription.xml.",
         " * Do not edit: generate it again. */",
         f"#ifndef {guard}",
         f"#define {guard}",
@@ -206,7 +200,7 @@ def build_description(name: str, fmi: str, c_files, headers) -> bytes:
     SubElement(files, "IncludeDirectory", name=".")
     SubElement(config, "Library", name="m", external="true",
                description="the C math library (link with -lm where it is apart from the C library)")
-    return tostring(root, xml_declaration=True, encoding="UTF-8")
+    return tostring(xml_tree(root, f"{name}'s buildDescription.xml"), xml_declaration=True, encoding="UTF-8")
 
 
 def generated_files(name: str, fmi: str, version: str, sources: dict[str, bytes], model: NativeModel | None = None,
@@ -225,6 +219,7 @@ def generated_files(name: str, fmi: str, version: str, sources: dict[str, bytes]
     else:
         md = model_description(name, model.description, token, model.interface(), version, c_files, step=step)
     files["buildDescription.xml"] = build_description(name, fmi, c_files, sorted(p for p in files if p.endswith(".h")))
+    xml_tree(md, f"{name}'s modelDescription.xml")
     return {"modelDescription.xml": tostring(md, xml_declaration=True, encoding="UTF-8"),
             **{f"sources/{path}": data for path, data in files.items()},
             **documentation_files(name, model.description, fmi, version, model.interface(), model.convention)}

@@ -1,16 +1,16 @@
-"""Model descriptions written from a table of variables (fmu_src.variables): the FMI 2.0
+"""Model descriptions written from a table of variables (systems.fmi.interface.variables): the FMI 2.0
 UnitDefinitions, TypeDefinitions, DefaultExperiment, ModelVariables and ModelStructure and the
 metadata of every FMU the project builds (pythonfmu's through fmu_support.ProjectSlave.to_xml),
 and the whole document of a native one, FMI 2.0 (model_description) or 3.0 (model_description3;
-fmu_src/generate.py writes them). Only the standard library is imported: the build runs it."""
+systems/fmi/interface/generate.py writes them). Only the standard library is imported: the build runs it."""
 from __future__ import annotations
 
-import math
 import os
 import time
 from xml.etree.ElementTree import Element, SubElement
 
-from attitude_fmu.fmu_src.variables import (
+from attitude_fmu.systems.fmi.interface.escaping import xml_double
+from attitude_fmu.systems.fmi.interface.variables import (
     BOOLEAN,
     DISPLAY_UNITS,
     ENUMERATION,
@@ -42,12 +42,12 @@ LOG_CATEGORIES = {
 
 
 def start_text(variable) -> str:
-    """A start value as the model description writes it: Reals exactly (shortest round trip,
-    NaN as XML Schema spells it; an array's elements separated by spaces), Booleans true/false,
+    """A start value as the model description writes it: Reals exactly as xs:double spells them
+    (escaping.xml_double; an array's elements separated by spaces), Booleans true/false,
     Enumerations by their value."""
     if variable.type == REAL:
         values = variable.start if variable.dimensions else (variable.start,)
-        return " ".join("NaN" if math.isnan(x) else repr(float(x)) for x in values)
+        return " ".join(map(xml_double, values))
     if variable.type == BOOLEAN:
         return "true" if variable.start else "false"
     return str(variable.start)
