@@ -84,12 +84,12 @@ int human_stream_step(HumanStream *s, double start, double end, double out[HUMAN
     if (!(isfinite(start) && isfinite(end) && start <= end && start >= s->t - 1e-9 * fmax(1.0, s->t)))
         return refuse(message, size, "the human motion steps forward from time 0 s: not over (%s, %s] s after %s s",
                       float_repr(start, a), float_repr(end, b), float_repr(s->t, c));
-    if (ceil(end / G) > HUMAN_MAX_GRID)
-        return refuse(message, size, "a step to %s s ends beyond the human motion's grid (%.0f cells of %s s)",
-                      float_repr(end, a), HUMAN_MAX_GRID, float_repr(G, b));
     if (ceil(end / G) - (double)s->k > HUMAN_MAX_CELLS)
         return refuse(message, size, "a step to %s s needs more than %.0f cells of the human motion's grid (%s s)",
                       float_repr(end, a), HUMAN_MAX_CELLS, float_repr(G, b));
+    if (ceil(end / G) > HUMAN_MAX_GRID)
+        return refuse(message, size, "a step to %s s ends beyond the human motion's grid (%.0f cells of %s s)",
+                      float_repr(end, a), HUMAN_MAX_GRID, float_repr(G, b));
     start = fmax(start, s->t);
     Quat turn = {1.0, 0.0, 0.0, 0.0};
     double dv[3] = {0.0, 0.0, 0.0}, t = start, w0[3] = {0.0, 0.0, 0.0};
