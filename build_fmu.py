@@ -15,9 +15,9 @@ from __future__ import annotations
 import argparse
 import importlib.metadata
 import importlib.util
-import os
 import re
 import shutil
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -73,16 +73,17 @@ def project_version() -> str:
 
 def build_clone(build_dir=ROOT / "build") -> None:
     """The clone built by CMake in build_dir, and what the build installs (the extension module,
-    built/) put into the clone's folder, each file replaced whole: a process may have the old one loaded."""
+    built/) put into the clone's folder, each file replaced whole (systems.recordings.output.copy_file):
+    a process may have the old one loaded."""
+    from attitude_fmu.systems.recordings.output import copy_file
+
     staged = Path(cmake_build(build_dir)) / "install"
     shutil.rmtree(staged, ignore_errors=True)
     subprocess.run([_tool("cmake"), "--install", str(build_dir), "--prefix", str(staged)], check=True)
     for path in sorted(p for p in staged.rglob("*") if p.is_file()):
         target = ROOT / path.relative_to(staged)
         target.parent.mkdir(parents=True, exist_ok=True)
-        partial = target.with_name(f".{target.name}.{os.getpid()}")
-        shutil.copy2(path, partial)
-        os.replace(partial, target)
+        copy_file(path, target)
 
 
 def main(argv=None) -> int:
@@ -96,15 +97,30 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     package = _package()
     from attitude_fmu.systems.fmi.platforms import parse_platforms
+    from attitude_fmu.systems.recordings.output import interrupting
 
     try:
         platforms = parse_platforms(args.platforms)
     except ValueError as exc:
         parser.error(str(exc))
-    if not __package__ and (ROOT / "CMakeLists.txt").is_file():  # a clone
-        build_clone()
-    for path in package.build_fmus(args.out, platforms=platforms):
-        print(path)
+    try:
+        with interrupting():  # SIGTERM, SIGHUP, SIGINT: temporary folders and files removed, outputs as they were
+            if not __package__ and (ROOT / "CMakeLists.txt").is_file():  # a clone
+                build_clone()
+            for path in package.build_fmus(args.out, platforms=platforms):
+                print(path)
+    except subprocess.CalledProcessError as exc:
+        print(f"build_fmu: error: {Path(exc.cmd[0]).name} failed (exit {exc.returncode}); its output above says why",
+              file=sys.stderr)
+        return 2
+    except (ValueError, OSError, RuntimeError) as exc:
+        print(f"build_fmu: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt as exc:
+        signum = getattr(exc, "signum", signal.SIGINT)
+        print(f"build_fmu: interrupted by {signal.Signals(signum).name}; no output was left half-written",
+              file=sys.stderr)
+        return 128 + signum
     return 0
 
 

@@ -12,6 +12,7 @@ import os
 import signal
 import socket
 import stat
+import struct
 import subprocess
 import sys
 import threading
@@ -390,7 +391,8 @@ def test_epoch_nanoseconds_keep_every_step(tmp_path, imu, capsys):
 @contextlib.contextmanager
 def _server(greeting: bytes | None):
     """A TCP server on the loopback interface: an HTTP server (greeting None), or one that
-    sends greeting to every connection; yields its port."""
+    sends greeting to every connection and then reads, saying nothing more, until the other
+    side hangs up; yields its port."""
     if greeting is None:
         import http.server
 
@@ -402,7 +404,8 @@ def _server(greeting: bytes | None):
             def handle(self):
                 with contextlib.suppress(OSError):  # the command hangs up without a word
                     self.request.sendall(greeting)
-                    self.request.recv(1024)
+                    while self.request.recv(1024):
+                        pass
 
         server = socketserver.ThreadingTCPServer(("127.0.0.1", 0), Greeter)
     server.daemon_threads = True
@@ -426,6 +429,21 @@ def test_a_scheduler_address_where_no_scheduler_listens_is_refused_in_seconds(gr
     err = capsys.readouterr().err
     assert f"tcp://127.0.0.1:{port} is no Dask scheduler" in err and err.count("\n") == 1, err
     assert took < 10.0 if greeting is None else took < 3.0
+
+
+def test_a_scheduler_that_greets_and_then_says_nothing_is_given_up_on_within_30_s(capsys):
+    """A server that sends a plausible frame length (a Dask scheduler's greeting starts so) and then
+    nothing: the client's handshake is given up on (HANDSHAKE_DEADLINE_S), one line, exit 2."""
+    from attitude_fmu.systems.cluster.jobs import HANDSHAKE_DEADLINE_S
+
+    with _server(struct.pack("<Q", 200)) as port:
+        start = time.monotonic()
+        assert main(["table1", "--duration", "10", "--scheduler", f"tcp://127.0.0.1:{port}"]) == 2
+        took = time.monotonic() - start
+    err = capsys.readouterr().err
+    assert err == (f"attitude: error: the Dask scheduler at tcp://127.0.0.1:{port} did not finish its handshake in "
+                   f"{HANDSHAKE_DEADLINE_S:g} s\n"), err
+    assert HANDSHAKE_DEADLINE_S <= took < 30.0
 
 
 def test_a_real_scheduler_passes_the_check_and_its_dashboard_does_not():

@@ -189,3 +189,64 @@ def test_a_worker_that_ran_fmus_ends_with_status_0_where_exit_would_crash_it(fmu
             results = jobs.map(_load_and_step, [job, job], ["a", "b"])
     assert np.allclose(results, [[0.0, 0.0, 1.0]] * 2, atol=1e-9), results
     assert statuses == [0, 0], statuses
+
+
+def _sleep(seconds: float) -> float:
+    """A job that takes seconds."""
+    time.sleep(seconds)
+    return seconds
+
+
+@pytest.fixture
+def one_worker():
+    """A local cluster of one worker process, and that process's id; the process is let go on (SIGCONT) after
+    the test, whatever it did to it."""
+    from distributed import Client, LocalCluster
+
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address="127.0.0.1:0") as cluster:
+        with Client(cluster) as client:
+            pid = next(iter(client.run(os.getpid).values()))
+        try:
+            yield cluster.scheduler_address, pid
+        finally:
+            os.kill(pid, signal.SIGCONT)
+
+
+def test_a_stopped_worker_is_given_up_on_before_any_job(one_worker, monkeypatch):
+    """Its only worker stopped (SIGSTOP) before the run: the check of the workers' version ends at
+    PROBE_DEADLINE_S with a message that says so, not after the scheduler's own minutes."""
+    from attitude_fmu.systems.cluster import jobs as cluster_jobs
+
+    monkeypatch.setattr(cluster_jobs, "PROBE_DEADLINE_S", 3.0)
+    address, pid = one_worker
+    os.kill(pid, signal.SIGSTOP)
+    start = time.monotonic()
+    with pytest.raises(RuntimeError, match=f"the Dask scheduler at {address} or its workers did not answer in 3 s"):
+        with Jobs(scheduler=address, bar=False) as jobs:
+            jobs.map(_sleep, [(0.0,), (0.0,)], ["a", "b"])
+    assert time.monotonic() - start < 15.0
+
+
+def test_a_worker_stopped_mid_run_is_given_up_on(one_worker, monkeypatch):
+    """Its only worker stopped while it runs a job: after SILENCE_S without a job ending, the workers are
+    asked, and the one that does not answer within PROBE_DEADLINE_S ends the run with a message."""
+    from attitude_fmu.systems.cluster import jobs as cluster_jobs
+
+    monkeypatch.setattr(cluster_jobs, "SILENCE_S", 1.0)
+    monkeypatch.setattr(cluster_jobs, "PROBE_DEADLINE_S", 2.0)
+    address, pid = one_worker
+    threading.Timer(1.5, os.kill, (pid, signal.SIGSTOP)).start()
+    start = time.monotonic()
+    with pytest.raises(RuntimeError, match="ran no job to its end for 1 s and one did not answer in 2 s"):
+        with Jobs(scheduler=address, bar=False) as jobs:
+            jobs.map(_sleep, [(30.0,), (30.0,)], ["a", "b"])
+    assert time.monotonic() - start < 15.0
+
+
+def test_slow_jobs_on_answering_workers_are_waited_for(one_worker, monkeypatch):
+    """Jobs longer than SILENCE_S on a worker that answers: asked, it answers, and the run goes on."""
+    from attitude_fmu.systems.cluster import jobs as cluster_jobs
+
+    monkeypatch.setattr(cluster_jobs, "SILENCE_S", 0.5)
+    with Jobs(scheduler=one_worker[0], bar=False) as jobs:
+        assert jobs.map(_sleep, [(1.5,), (0.1,)], ["a", "b"]) == [1.5, 0.1]

@@ -22,7 +22,7 @@ from attitude_fmu.blocks.stages.timing import ACC_SAMPLES, GYR_SAMPLES, MAX_LATE
 from attitude_fmu.systems.cli.simulate import add_parser as add_simulate_parser
 from attitude_fmu.systems.cli.simulate import cmd_simulate
 from attitude_fmu.systems.recordings.checks import RATE_RANGE_HZ
-from attitude_fmu.systems.recordings.output import STDIO, check_output, same_file
+from attitude_fmu.systems.recordings.output import STDIO, check_output, interrupting, same_file
 from attitude_fmu.systems.recordings.reading import MAX_GAP_S
 from attitude_fmu.systems.recordings.recording import (
     ACC_UNITS,
@@ -715,8 +715,9 @@ def cmd_ssp(args) -> int:
     if args.fmi_version == "3.0" and args.chain == "python":
         raise ValueError("the pythonfmu FMUs are FMI 2.0 only: --fmi-version 3.0 takes the native ones")
     chain = "fmi3" if args.fmi_version == "3.0" else args.chain
-    for path in write_verify_ssps(_verified_fmus(args), args.out, args.profile, args.method, chain):
-        print(path)
+    with interrupting():  # SIGTERM or SIGHUP: the SSP being written and its temporary file removed
+        for path in write_verify_ssps(_verified_fmus(args), args.out, args.profile, args.method, chain):
+            print(path)
     return 0
 
 
@@ -847,9 +848,11 @@ def cmd_export(args) -> int:
     from attitude_fmu.systems.fmi.export.source import load_system
 
     _check_out(args.out)
-    system, x0 = load_system(args.system)
-    path = export_fmu(system, args.out, x0=x0, step=args.step, fmi_version=args.fmi_version, platforms=args.platforms,
-                      name=args.name, backend=args.backend, log=lambda m: print(f"attitude: {m}", file=sys.stderr))
+    with interrupting():  # SIGTERM or SIGHUP: the build folders and the temporary FMU removed, the output kept
+        system, x0 = load_system(args.system)
+        path = export_fmu(system, args.out, x0=x0, step=args.step, fmi_version=args.fmi_version,
+                          platforms=args.platforms, name=args.name, backend=args.backend,
+                          log=lambda m: print(f"attitude: {m}", file=sys.stderr))
     print(path)
     return 0
 

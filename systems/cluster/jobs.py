@@ -16,6 +16,7 @@ import os
 import socket
 import struct
 import sys
+import threading
 import uuid
 from dataclasses import dataclass
 
@@ -24,6 +25,9 @@ CONNECT_TIMEOUT_S = 10.0  # for --scheduler ADDRESS
 GREETING_TIMEOUT_S = 5.0  # a Dask scheduler's first message follows the connection at once
 MAX_GREETING_BYTES = 1 << 20  # its length comes first; a handshake takes a few hundred bytes
 SCHEDULER_SCHEMES = ("tcp", "tls", "ws", "wss")  # a scheduler in another process; inproc:// is one in this process
+HANDSHAKE_DEADLINE_S = 20.0  # a scheduler that greets and then says nothing more is given up on after this
+SILENCE_S = 60.0  # jobs on a scheduler's workers with none ending this long: the workers are asked whether they answer
+PROBE_DEADLINE_S = 30.0  # ... and given up on when one does not answer within this (a stopped worker, a lost machine)
 DEFAULT_SCHEDULER_PORT = 8786
 WORKER_PLUGIN = "attitude-fmu-worker-exit"
 
@@ -115,7 +119,7 @@ class Jobs:
                    for i, job in enumerate(jobs)]
         index = {future.key: i for i, future in enumerate(futures)}
         outcomes = [None] * len(jobs)
-        for future in as_completed(futures):
+        for future in as_completed(futures) if self.scheduler is None else self._answered(futures):
             try:
                 outcomes[index[future.key]] = future.result()
             except KilledWorker as exc:
@@ -124,6 +128,24 @@ class Jobs:
             future.release()
             bar.update()
         return outcomes
+
+    def _answered(self, futures):
+        """The futures as they end, on a scheduler whose workers are asked, after SILENCE_S with none ending,
+        whether they still answer (RuntimeError where one does not within PROBE_DEADLINE_S): a stopped worker
+        holds its jobs until the scheduler's own timeout, minutes later."""
+        from distributed import wait
+
+        pending = set(futures)
+        while pending:
+            try:
+                done, pending = wait(pending, timeout=SILENCE_S, return_when="FIRST_COMPLETED")
+            except TimeoutError:
+                within(PROBE_DEADLINE_S, lambda: self.client.run(os.getpid),
+                       f"the workers of {self.scheduler} ran no job to its end for {SILENCE_S:g} s and one did not "
+                       f"answer in {PROBE_DEADLINE_S:g} s (stopped, or its machine lost); restart it or run without "
+                       "--scheduler")
+                continue
+            yield from done
 
     def _start(self, jobs: int):
         """The client, connected on first use: to the scheduler, or to a local cluster of
@@ -148,7 +170,11 @@ class Jobs:
         else:
             check_scheduler(self.scheduler)
             try:
-                self.client = Client(self.scheduler, timeout=CONNECT_TIMEOUT_S)
+                self.client = within(HANDSHAKE_DEADLINE_S, lambda: Client(self.scheduler, timeout=CONNECT_TIMEOUT_S),
+                                     f"the Dask scheduler at {self.scheduler} did not finish its handshake in "
+                                     f"{HANDSHAKE_DEADLINE_S:g} s")
+            except RuntimeError:
+                raise
             except Exception as exc:  # Dask raises many types: the address, the handshake, the security settings
                 raise RuntimeError(f"cannot connect to the Dask scheduler at {self.scheduler}: "
                                    f"{str(exc) or type(exc).__name__}") from None
@@ -158,11 +184,14 @@ class Jobs:
 
     def _check_workers(self) -> None:
         """Refuse a cluster without workers, or whose workers lack this package or run another version."""
-        if not self.client.scheduler_info(n_workers=-1)["workers"]:
+        late = f"the Dask scheduler at {self.scheduler} or its workers did not answer in {PROBE_DEADLINE_S:g} s"
+        if not within(PROBE_DEADLINE_S, lambda: self.client.scheduler_info(n_workers=-1), late)["workers"]:
             raise RuntimeError(f"the Dask scheduler at {self.scheduler} has no workers; start some with: "
                                f"dask worker {self.scheduler}")
         try:
-            versions = self.client.run(installed_version)
+            versions = within(PROBE_DEADLINE_S, lambda: self.client.run(installed_version), late)
+        except RuntimeError:
+            raise
         except Exception as exc:  # the worker cannot unpickle a function of this package: it lacks it
             raise RuntimeError(f"the workers of {self.scheduler} cannot run this package's jobs ({exc}); "
                                "install attitude-fmu on every worker (docs/distributed.md)") from None
@@ -185,6 +214,27 @@ class Jobs:
             rest = "the others completed" if len(failed) < len(outcomes) else "none completed"
             print(f"attitude: error: {len(failed)} of {len(outcomes)} {what} failed "
                   f"({', '.join(name for _, name, _ in failed)}); {rest}", file=sys.stderr)
+
+
+def within(seconds: float, call, late: str):
+    """call()'s result, or its exception, if it ends within seconds; else RuntimeError(late). The call is
+    left to end in a daemon thread (a Dask client waiting on a socket cannot be interrupted)."""
+    result = {}
+
+    def run():
+        try:
+            result["value"] = call()
+        except BaseException as exc:  # handed to the caller's thread
+            result["error"] = exc
+
+    thread = threading.Thread(target=run, name="attitude-deadline", daemon=True)
+    thread.start()
+    thread.join(seconds)
+    if thread.is_alive():
+        raise RuntimeError(late)
+    if "error" in result:
+        raise result["error"]
+    return result["value"]
 
 
 def scheduler_endpoint(address: str) -> tuple[str, str, int]:

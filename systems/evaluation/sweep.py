@@ -32,6 +32,9 @@ TUNING_WARNING = ("attitude: warning: the best combination was chosen on the rec
                   "the rest: --score-on FILE...")
 
 
+MAX_COMBINATIONS = 10_000  # combinations of one sweep, each run on every recording; counted before any is made
+
+
 def parse_grid(text: str) -> tuple[str, tuple[float, ...]]:
     """NAME=V1,V2,... as (name, values); values are numbers in the parameter's unit."""
     name, sep, values = text.partition("=")
@@ -64,6 +67,10 @@ def _check(paths, grid, setup: Setup, score_on) -> None:
     twice = sorted({name for name in names if names.count(name) > 1} | set(names) & set(setup.params or {}))
     if twice:
         raise ValueError(f"{', '.join(twice)} given more than once: a parameter takes one --grid or one --param")
+    count = math.prod(len(values) for _, values in grid)
+    if count > MAX_COMBINATIONS:
+        raise ValueError(f"the grid makes {count} combinations ({' × '.join(str(len(v)) for _, v in grid)}); a sweep "
+                         f"runs {MAX_COMBINATIONS} at most: give fewer values, or sweep the parameters in turn")
     for combination in combinations(grid):
         _with(setup, combination).check()
     both = sorted({str(Path(p).resolve()) for p in paths} & {str(Path(p).resolve()) for p in score_on})

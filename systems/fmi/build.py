@@ -36,6 +36,7 @@ from attitude_fmu.systems.fmi.interface.documentation import write_documentation
 from attitude_fmu.systems.fmi.carried_code import PACKAGE, code_digest
 from attitude_fmu.systems.fmi import fmi3, platforms as cross
 from attitude_fmu.systems.fmi.native import NATIVE_NAMES, NotBuilt, built, copy_fmus, is_current
+from attitude_fmu.systems.recordings.output import copy_file, replaced
 
 FMU_NAMES = ("AttitudeEstimator", "ImuSensor", "MotionProfile")
 PACKAGE_DIR = Path(attitude_fmu.__file__).resolve().parent
@@ -162,7 +163,9 @@ def build_fmus(out, names=FMU_NAMES, native=NATIVE_NAMES, fmi3_names=fmi3.FMI3_N
     """Build the named pythonfmu FMUs into the directory out, and copy the named native ones
     into out/native and the named FMI 3.0 ones into out/native/fmi3 (none where the package's
     build did not make them: a warning says so), with the binaries of the platforms (FMI 3.0
-    tuples, systems.fmi.platforms.add_platforms) added to those; returns their paths."""
+    tuples, systems.fmi.platforms.add_platforms) added to those; returns their paths. Each FMU is
+    made in a temporary folder and written into out whole (systems.recordings.output.replaced): an
+    interrupted or failed build leaves out's files as they were."""
     from pythonfmu.builder import FmuBuilder
 
     out = Path(out)
@@ -178,14 +181,14 @@ def build_fmus(out, names=FMU_NAMES, native=NATIVE_NAMES, fmi3_names=fmi3.FMI3_N
                 shutil.copy2(PACKAGE_DIR / relative, staged / relative)
             documentation = write_documentation(Path(tmp) / name / "documentation", name, adapter_description(name),
                                                 project_version())
-            built_fmus.append(Path(FmuBuilder.build_FMU(SOURCE_DIR / f"{name}.py", dest=out, project_files=[staged],
-                                                        documentation_folder=documentation,
-                                                        needsExecutionTool="false", canGetAndSetFMUstate="true",
-                                                        canSerializeFMUstate="true")))
-    for path in built_fmus:
-        guarded(path, guard)
-        with zipfile.ZipFile(path, "a", zipfile.ZIP_DEFLATED) as zf:
-            zf.writestr(FINGERPRINT, source_fingerprint(path.stem) + "\n")
+            path = Path(FmuBuilder.build_FMU(SOURCE_DIR / f"{name}.py", dest=Path(tmp) / "out",
+                                             project_files=[staged], documentation_folder=documentation,
+                                             needsExecutionTool="false", canGetAndSetFMUstate="true",
+                                             canSerializeFMUstate="true"))
+            guarded(path, guard)
+            with zipfile.ZipFile(path, "a", zipfile.ZIP_DEFLATED) as zf:
+                zf.writestr(FINGERPRINT, source_fingerprint(path.stem) + "\n")
+            built_fmus.append(copy_file(path, out / path.name))
     copied = copy_fmus(out / "native", native) + fmi3.copy_fmi3_fmus(out / "native" / "fmi3", fmi3_names)
     if platforms and copied:
         cross.add_platforms(copied, platforms, log=lambda m: print(m, file=sys.stderr))
@@ -221,8 +224,7 @@ def install_guard(fmu: Path, guard: Path) -> None:
     platform = guard_platform()
     suffix = ".dylib" if platform == "darwin64" else ".so"
     binary = f"binaries/{platform}/{fmu.stem}{suffix}"
-    staged = fmu.with_suffix(".guarded")
-    with zipfile.ZipFile(fmu) as src, zipfile.ZipFile(staged, "w", zipfile.ZIP_DEFLATED) as dst:
+    with zipfile.ZipFile(fmu) as src, replaced(fmu) as fh, zipfile.ZipFile(fh, "w", zipfile.ZIP_DEFLATED) as dst:
         if binary not in src.namelist():
             raise RuntimeError(f"{fmu} has no {binary} to guard")
         for item in src.infolist():
@@ -231,7 +233,6 @@ def install_guard(fmu: Path, guard: Path) -> None:
                 name = f"binaries/{platform}/{PYTHONFMU_LIBRARY}"
                 dst.write(guard, binary)
             dst.writestr(name if name != item.filename else item, src.read(item))
-    staged.replace(fmu)
 
 
 def guarded(fmu: Path, guard: Path | None) -> None:

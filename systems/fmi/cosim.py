@@ -13,8 +13,11 @@ the same SSP in a second importer, independent of fmpy (libcosim).
 """
 from __future__ import annotations
 
+import contextlib
+import math
 import os
 import shutil
+import tempfile
 from collections import defaultdict
 from pathlib import Path
 
@@ -82,23 +85,29 @@ def fmus_loaded() -> bool:
     return _loaded
 
 
-class _Component:
-    """One instantiated FMU of the SSD with its variable references."""
+MAX_STEPS = 10_000_000  # communication steps of one cosimulate run (28 h at 0.01 s): the record is kept in memory
 
-    def __init__(self, element, ssp_dir: Path):
-        fmu_path = ssp_dir / element.source
+
+class _Component:
+    """One instantiated FMU of the SSD with its variable references, extracted into unzipdir."""
+
+    def __init__(self, element, ssp_dir: Path, unzipdir: Path):
+        fmu_path = _source(element, ssp_dir)
         self.name = element.name
-        self.md = read_model_description(fmu_path)
+        try:
+            self.md = read_model_description(fmu_path)
+            self.unzipdir = extract(fmu_path, unzipdir=unzipdir)
+        except Exception as exc:  # fmpy's refusals of an archive or its XML are plain Exceptions
+            raise ValueError(f"component {element.name}: {element.source} is no FMU fmpy can read: "
+                             f"{one_line(exc)}") from None
         self.variables = {v.name: v for v in self.md.modelVariables}
-        self.unzipdir = extract(fmu_path)
         cwd = os.getcwd()  # fmpy enters the binary's folder to load it, and stays there where that fails
         try:
             self.fmu = load_slave(self.md, self.unzipdir, element.name)
-        except Exception as exc:  # a binary that does not load (another platform's, broken): its folder goes
+        except Exception as exc:  # a binary that does not load (another platform's, broken)
             os.chdir(cwd)
-            shutil.rmtree(self.unzipdir, ignore_errors=True)
-            raise RuntimeError(f"component {element.name}: its binary ({element.source}) failed to load: {exc}"
-                               ) from exc
+            raise RuntimeError(f"component {element.name}: its binary ({element.source}) failed to load: "
+                               f"{one_line(exc)}") from None
         self.outputs = [v.name for v in self.md.modelVariables if v.causality == "output"]
         self.real_out = [n for n in self.outputs if self.variables[n].type == "Real"]
         self.bool_out = [n for n in self.outputs if self.variables[n].type == "Boolean"]
@@ -128,21 +137,72 @@ class _Component:
     def stop(self):
         self.fmu.terminate()
         self.fmu.freeInstance()
-        shutil.rmtree(self.unzipdir, ignore_errors=True)
 
 
 def cosimulate(ssp_path, stop_time: float, step_size: float, progress=None) -> dict[str, np.ndarray]:
     """Run the SSP from 0 to stop_time (s) with a fixed step (s).
 
     Returns "time" (end of each step) and every output as "component.variable", one
-    value per step. progress(fraction) is called about every 1 % when given.
+    value per step. progress(fraction) is called about every 1 % when given. ValueError, in
+    one line, for a stop time or step that is not finite and positive or makes more than
+    MAX_STEPS steps, a file that is no SSP fmpy reads, a component whose source is not an
+    FMU inside the SSP (an absolute path or one leaving it is refused, never loaded), and bad
+    connections or parameters; RuntimeError for a component that fails to load or step.
+    Nothing extracted outlives the call.
     """
-    ssd = read_ssd(str(ssp_path))
-    ssp_dir = Path(extract(str(ssp_path)))
+    n = step_count(stop_time, step_size)
+    try:
+        ssd = read_ssd(str(ssp_path))
+    except Exception as exc:  # zipfile's, lxml's and fmpy's own (a plain Exception) refusals
+        raise ValueError(f"{ssp_path} is no SSP fmpy can read: {one_line(exc)}") from None
+    with tempfile.TemporaryDirectory(prefix="attitude_fmu_ssp_") as tmp:
+        return _run_ssd(ssd, ssp_path, Path(tmp), n, step_size, progress)
+
+
+def step_count(stop_time: float, step_size: float) -> int:
+    """The communication steps from 0 to stop_time (s) of step_size (s); ValueError unless both are finite and
+    positive and they make 1 to MAX_STEPS steps."""
+    for name, value in (("stop time", stop_time), ("step size", step_size)):
+        if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)) \
+                or not math.isfinite(value) or value <= 0:
+            raise ValueError(f"the {name} must be a finite positive number of seconds, got {value!r}")
+    n = round(stop_time / step_size)
+    if not 1 <= n <= MAX_STEPS:
+        raise ValueError(f"a stop time of {stop_time!r} s in steps of {step_size!r} s makes {n} steps; "
+                         f"cosimulate runs 1 to {MAX_STEPS}")
+    return n
+
+
+def _source(element, ssp_dir: Path) -> Path:
+    """The FMU file of the SSD's component element, inside the extracted SSP ssp_dir; ValueError for a
+    source that is absolute, leaves the SSP, or names no file in it."""
+    source = str(element.source or "")
+    path = (ssp_dir / source).resolve()
+    if Path(source).is_absolute() or "\\" in source or not path.is_relative_to(ssp_dir.resolve()):
+        raise ValueError(f"component {element.name}: its source {source!r} is outside the SSP; an SSP's "
+                         "components are FMUs inside it (resources/NAME.fmu)")
+    if not path.is_file():
+        raise ValueError(f"component {element.name}: the SSP holds no file {source!r}")
+    return path
+
+
+def one_line(exc: BaseException) -> str:
+    """An exception as one line of at most 300 characters: its type, and its message where it has one."""
+    message = " ".join(str(exc).split())[:300]
+    return f"{type(exc).__name__}" + (f": {message}" if message else "")
+
+
+def _run_ssd(ssd, ssp_path, tmp: Path, n: int, step_size: float, progress) -> dict[str, np.ndarray]:
+    """cosimulate's run of the SSD read from ssp_path, extracted into tmp, for n steps of step_size: its record."""
+    ssp_dir = tmp / "ssp"
+    try:
+        extract(str(ssp_path), unzipdir=ssp_dir)
+    except Exception as exc:
+        raise ValueError(f"{ssp_path} cannot be extracted: {one_line(exc)}") from None
     components = {}
     try:
-        for element in ssd.system.elements:
-            components[element.name] = _Component(element, ssp_dir)
+        for k, element in enumerate(ssd.system.elements):
+            components[element.name] = _Component(element, ssp_dir, tmp / f"component-{k}")
         for c in ssd.system.connections:
             _connect(components, c)
         order = _stepping_order(components)
@@ -152,7 +212,6 @@ def cosimulate(ssp_path, stop_time: float, step_size: float, progress=None) -> d
                 components[element.name].start(params, 0.0)
             except FMICallException as exc:
                 raise RuntimeError(f"component {element.name} failed to initialise: {exc}") from None
-        n = int(round(stop_time / step_size))
         # the record's columns: each component's Real outputs, then its Boolean ones, in stepping order
         columns = {f"{c.name}.{v}": (c, v) for c in order for v in c.real_out + c.bool_out}
         values = _steps(order, list(columns), n, step_size, progress)
@@ -162,11 +221,8 @@ def cosimulate(ssp_path, stop_time: float, step_size: float, progress=None) -> d
         return record
     finally:
         for comp in components.values():
-            try:
+            with contextlib.suppress(Exception):  # an instance that never started has nothing to free
                 comp.stop()
-            except Exception:  # an instance that never started has nothing to free
-                shutil.rmtree(comp.unzipdir, ignore_errors=True)
-        shutil.rmtree(ssp_dir, ignore_errors=True)
 
 
 def _connect(components: dict, c) -> None:
@@ -241,6 +297,7 @@ def cosimulate_libcosim(ssp_path, stop_time: float, step_size: float, progress=N
         from libcosimpy.CosimObserver import CosimObserver
     except ImportError:
         raise RuntimeError("the libcosim master needs libcosimpy: pip install libcosimpy (CPython >= 3.11)") from None
+    n = step_count(stop_time, step_size)
     log_output_level(CosimLogLevel.WARNING)
     global _loaded
     _loaded = True
@@ -260,7 +317,6 @@ def cosimulate_libcosim(ssp_path, stop_time: float, step_size: float, progress=N
             if chosen:
                 reads.append((slave.index, reader, [v.reference for v in chosen],
                               [f"{slave.name.decode()}.{v.name.decode()}" for v in chosen], dtype))
-    n = int(round(stop_time / step_size))
     record = {name: np.empty(n, dtype=dtype) for *_, names, dtype in reads for name in names}
     for k in range(n):
         if not ex.step():

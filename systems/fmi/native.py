@@ -21,7 +21,6 @@ is told apart (is_current). `pip install` builds and installs them all; in a clo
 """
 from __future__ import annotations
 
-import shutil
 import sys
 from pathlib import Path
 
@@ -84,4 +83,6 @@ def copy_fmus(out, names, folder: str = "native", log=lambda m: print(m, file=sy
         return []
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    return [Path(shutil.copyfile(source, out / source.name)) for source in sources]
+    from attitude_fmu.systems.recordings.output import copy_file
+
+    return [copy_file(source, out / source.name) for source in sources]

@@ -90,8 +90,9 @@ def binaries(folder: Path, fmi: int, name: str) -> dict[str, Path]:
 def add_binaries(fmu: Path, files: dict[str, Path]) -> None:
     """The files (path in the FMU → file) written into the FMU at fmu, any entry of the same path replaced;
     the FMU is rewritten whole and replaces the old one at once."""
-    staged = fmu.with_name(f".{fmu.name}.{os.getpid()}")
-    with zipfile.ZipFile(fmu) as src, zipfile.ZipFile(staged, "w", zipfile.ZIP_DEFLATED) as dst:
+    from attitude_fmu.systems.recordings.output import replaced
+
+    with zipfile.ZipFile(fmu) as src, replaced(fmu) as fh, zipfile.ZipFile(fh, "w", zipfile.ZIP_DEFLATED) as dst:
         for item in src.infolist():
             if item.filename not in files:
                 dst.writestr(item, src.read(item))
@@ -99,7 +100,6 @@ def add_binaries(fmu: Path, files: dict[str, Path]) -> None:
             info = zipfile.ZipInfo(path, date_time=(1980, 1, 2, 0, 0, 0))
             info.compress_type, info.external_attr = zipfile.ZIP_DEFLATED, 0o755 << 16
             dst.writestr(info, files[path].read_bytes())
-    os.replace(staged, fmu)
 
 
 def fmi_version(fmu: Path) -> int:

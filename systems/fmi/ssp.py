@@ -21,6 +21,7 @@ from xml.etree.ElementTree import Element, SubElement, register_namespace, tostr
 from attitude_fmu.systems.fmi.interface.generate import MODELS
 from attitude_fmu.systems.fmi.interface.variables import BOOLEAN, ENUMERATION, IN, INTEGER, OUT, PAR, REAL, item_value
 from attitude_fmu.systems.fmi.fmi3 import FOLDER as FMI3_FOLDER
+from attitude_fmu.systems.recordings.output import replaced
 
 SSD = "http://ssp-standard.org/SSP1/SystemStructureDescription"
 SSC = "http://ssp-standard.org/SSP1/SystemStructureCommon"
@@ -140,7 +141,7 @@ def write_ssp(path, fmu_dir, parameters: dict[str, dict], stop_time: float, step
                             {"startTime": "0.0", "stopTime": repr(float(stop_time))})
     SubElement(SubElement(_annotation(experiment, "com.opensimulationplatform"), f"{{{OSP}}}Algorithm"),
                f"{{{OSP}}}FixedStepAlgorithm", {"baseStepSize": step})
-    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as zf:
+    with replaced(path) as fh, zipfile.ZipFile(fh, "w", zipfile.ZIP_DEFLATED) as zf:
         zf.writestr("SystemStructure.ssd", tostring(root, xml_declaration=True, encoding="UTF-8"))
         for fmu in dict.fromkeys(fmu for fmu, _, _ in components.values()):
             zf.write(fmu_dir / f"{fmu}.fmu", f"resources/{fmu}.fmu")

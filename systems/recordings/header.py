@@ -95,7 +95,7 @@ def positions(path, header: list[str], columns: dict) -> dict:
     numbered."""
     absent = [theirs for theirs in columns.values() if not POSITION.match(theirs) and theirs not in header]
     if absent:
-        raise RecordingError(f"{path}: --column names {', '.join(absent)}, not in the header ({','.join(header)})")
+        raise RecordingError(f"{path}: --column names {', '.join(absent)}, not in the header ({shown(header)})")
     placed = {}
     for ours, theirs in columns.items():
         match = POSITION.match(theirs)
@@ -118,6 +118,19 @@ def positions(path, header: list[str], columns: dict) -> dict:
     return placed
 
 
+SHOWN_COLUMNS = 24  # the columns a message shows of a header: a wide file's header is not echoed whole
+
+
 def numbered(header: list[str]) -> str:
-    """The header as "#1 t, #2 gyro, #3 (unnamed), …"."""
-    return ", ".join(f"#{k + 1} {h or '(unnamed)'}" for k, h in enumerate(header))
+    """The header as "#1 t, #2 gyro, #3 (unnamed), …" (the first SHOWN_COLUMNS, then how many more)."""
+    return ", ".join(f"#{k + 1} {h or '(unnamed)'}" for k, h in enumerate(header[:SHOWN_COLUMNS])) + _more(header)
+
+
+def shown(header: list[str]) -> str:
+    """The header as a CSV line shows it, t,gyr_x,… (the first SHOWN_COLUMNS, then how many more)."""
+    return ",".join(header[:SHOWN_COLUMNS]) + _more(header)
+
+
+def _more(header: list[str]) -> str:
+    extra = len(header) - SHOWN_COLUMNS
+    return f", … and {extra} more of its {len(header)} columns" if extra > 0 else ""

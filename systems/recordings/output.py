@@ -12,6 +12,7 @@ from __future__ import annotations
 import contextlib
 import os
 import re
+import shutil
 import signal
 import socket
 import stat
@@ -105,13 +106,14 @@ def check_output(path, inputs=(), what: str = "an output") -> None:
 
 
 @contextlib.contextmanager
-def replaced(path):
+def replaced(path, mode: int | None = None):
     """A binary file to write path's new contents into (see written()): for a file, a
     temporary file in its folder, flushed to disk and renamed over it when the block ends
     without an exception, removed (the file untouched) when it raises or SIGTERM, SIGHUP or
     SIGINT arrives (Interrupted); a character device or a named pipe itself; path "-":
     standard output. This program's temporary files for the same file that an ended writer
-    left (killed by SIGKILL, a power cut) are removed first (remove_stale)."""
+    left (killed by SIGKILL, a power cut) are removed first (remove_stale). mode: the file's
+    permissions (default: those it has, or a new file's, 0o666 less the umask)."""
     if str(path) == STDIO:
         yield sys.stdout.buffer
         sys.stdout.buffer.flush()
@@ -131,11 +133,11 @@ def replaced(path):
     except OSError as exc:
         raise OutputError(f"cannot write {path}: {exc.strerror}") from None
     try:
-        with _removed_on_signal(temporary), os.fdopen(fd, "wb") as fh:
+        with interrupting(), os.fdopen(fd, "wb") as fh:
             yield fh
             fh.flush()
             os.fsync(fh.fileno())
-            os.chmod(temporary, _mode(target))
+            os.chmod(temporary, _mode(target) if mode is None else mode)
             os.replace(temporary, target)
     except BaseException as exc:
         with contextlib.suppress(OSError):
@@ -198,17 +200,16 @@ def _running(pid: int) -> bool:
 
 
 @contextlib.contextmanager
-def _removed_on_signal(temporary: str):
-    """Within the block, SIGTERM, SIGHUP and SIGINT remove the file temporary and raise
-    Interrupted; their previous handlers are restored after it. A signal ignored (nohup)
-    stays ignored; outside the main thread, where handlers cannot be set, nothing changes."""
+def interrupting():
+    """Within the block, SIGTERM, SIGHUP and SIGINT raise Interrupted (a KeyboardInterrupt), so
+    the block's own cleanup runs (finally clauses, temporary files and folders, child processes
+    that subprocess.run started); the previous handlers are restored after it. A signal ignored
+    (nohup) stays ignored; outside the main thread, where handlers cannot be set, nothing changes."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
 
     def handler(signum, frame):
-        with contextlib.suppress(OSError):
-            os.unlink(temporary)
         raise Interrupted(signum)
 
     previous = {}
@@ -231,6 +232,14 @@ def _mode(path: Path) -> int:
         umask = os.umask(0)
         os.umask(umask)
         return 0o666 & ~umask
+
+
+def copy_file(source, path) -> Path:
+    """The file source copied into path by replaced() (a file replaced whole with source's permissions, a
+    stream written); returns path."""
+    with open(source, "rb") as src, replaced(path, os.stat(source).st_mode & 0o7777) as fh:
+        shutil.copyfileobj(src, fh)
+    return Path(path)
 
 
 def save_figure(fig, path, **options) -> None:

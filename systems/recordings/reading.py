@@ -24,7 +24,14 @@ from attitude_fmu.systems.recordings.checks import (
     pile_up_notes,
     saturation_notes,
 )
-from attitude_fmu.systems.recordings.header import check_units, numbered, positions, without_units, written_units
+from attitude_fmu.systems.recordings.header import (
+    check_units,
+    numbered,
+    positions,
+    shown,
+    without_units,
+    written_units,
+)
 from attitude_fmu.systems.recordings.recording import (
     ACC_UNITS,
     GYR_UNITS,
@@ -45,6 +52,7 @@ from attitude_fmu.systems.recordings.tables import Source, csv_numbers, decimal_
 
 DELIMITERS = (",", ";", "\t")  # the header's most frequent one; with ";" or a tab, "," is a decimal comma
 MAX_GAP_S = 1.0  # longest run of missing samples filled in by default (s)
+MAX_HEADER_CHARS = 4 * 2**20  # a CSV's first line is read up to this: its header (100 000 named columns fit)
 MAX_LABEL_ROWS = 3  # rows without a number after the header that are skipped (units); more: refused
 DEFAULT_UNITS = {"gyr": "rad/s", "acc": "m/s2", "mag": "uT", "t": "s"}  # a unit flag not given
 
@@ -135,8 +143,12 @@ def _read_table(source: Source, fs: float | None, max_gap: float, used: dict, co
     if parquet:
         header = parquet_header(source)
     else:
+        source.refuse_padding()
         with source.text(newline="") as fh:
-            first = fh.readline()
+            first = fh.readline(MAX_HEADER_CHARS + 1)
+            if len(first) > MAX_HEADER_CHARS:
+                raise RecordingError(f"{path}: its first line, the header, runs past {MAX_HEADER_CHARS} characters; "
+                                     f"expected a header t,{','.join(IMU_COLUMNS)} (is it a CSV?)")
             following = list(itertools.islice(fh, MAX_LABEL_ROWS + 1))
         delimiter = max(DELIMITERS, key=first.count)
         header = next(csv.reader([first], delimiter=delimiter), None)
@@ -152,8 +164,8 @@ def _read_table(source: Source, fs: float | None, max_gap: float, used: dict, co
         next(csv.reader([line], delimiter=delimiter)) for line in labels]), used)
     missing = [c for c in IMU_COLUMNS if c not in header]
     if missing:
-        unclear = any(not h or header.count(h) > 1 for h in header)  # select by position
-        raise RecordingError(f"{path}: missing columns {', '.join(missing)} (header: {','.join(header)})"
+        unclear = "" in header or len(set(header)) < len(header)  # select by position
+        raise RecordingError(f"{path}: missing columns {', '.join(missing)} (header: {shown(header)})"
                              f"{'; name them by position, --column NAME=#N: ' + numbered(header) if unclear else ''}"
                              f"{_column_hint(missing, header)}")
     for group, what in ((MAG_COLUMNS, "the magnetometer"), (REF_COLUMNS, "the reference")):

@@ -3,7 +3,9 @@ numbers (CSV through pyarrow's reader, numpy's for what that one does not take; 
 with errors that name the source and say what was expected."""
 from __future__ import annotations
 
+import errno
 import io
+import os
 import sys
 import warnings
 from dataclasses import dataclass
@@ -23,10 +25,15 @@ SIGNATURES = {  # how other formats begin, to say what a file that is no text CS
 }
 
 
+MAX_STREAM_BYTES = 256 * 2**20  # a stream (standard input, a pipe) is read whole into memory up to this; a file is not
+CHUNK = 2**20  # bytes read at a time from a stream, and looked at at a time for a file's padding
+
+
 @dataclass(frozen=True)
 class Source:
     """A recording's bytes: a regular file (path), or what a stream gave (data: standard
-    input, a pipe, a process substitution), read whole. label names it in messages."""
+    input, a pipe, a process substitution), read whole up to MAX_STREAM_BYTES. label names it
+    in messages."""
 
     path: Path
     data: bytes | None = None
@@ -36,13 +43,14 @@ class Source:
         """The source of path: "-" is standard input; a path that is not a regular file but
         can be read (/dev/stdin, a named pipe) is read whole; anything else must be a file."""
         if str(path) == STDIO:
-            return cls(Path("stdin"), sys.stdin.buffer.read())
+            return cls(Path("stdin"), _stream(sys.stdin.buffer, "standard input"))
         path = Path(path)
         if path.is_file():
             return cls(path)
         if path.exists() and not path.is_dir():
             try:
-                return cls(path, path.read_bytes())
+                with path.open("rb") as fh:
+                    return cls(path, _stream(fh, str(path)))
             except OSError as exc:
                 raise RecordingError(f"{path}: cannot be read ({exc.strerror})") from None
         raise RecordingError(f"{path}: {'a folder, not a file' if path.is_dir() else 'no such file'}")
@@ -66,6 +74,28 @@ class Source:
         import pyarrow as pa
 
         return str(self.path) if self.data is None else pa.BufferReader(self.data)
+
+    def refuse_padding(self) -> None:
+        """RecordingError where the text ends in NUL bytes, as a logger's file preallocated on a card does:
+        how many, from which offset, and the command that cuts them (a file's tail is looked at, not read
+        whole)."""
+        if self.data is not None:
+            size, start = len(self.data), len(self.data.rstrip(b"\0"))
+        else:
+            with self.path.open("rb") as fh:
+                size = fh.seek(0, io.SEEK_END)
+                start = _data_end(fh.fileno(), size)
+                while start > 0:
+                    fh.seek(max(0, start - CHUNK))
+                    chunk = fh.read(start - max(0, start - CHUNK))
+                    kept = len(chunk.rstrip(b"\0"))
+                    start -= len(chunk) - kept
+                    if kept:
+                        break
+        if start < size:
+            cut = f"; cut them: truncate -s {start} {self.path}" if self.data is None else ""
+            raise RecordingError(f"{self.label}: its last {size - start} bytes (from offset {start}) are NUL, not "
+                                 f"text: a logger's preallocated space{cut}")
 
     def not_text(self, exc: UnicodeDecodeError) -> RecordingError:
         """The error for bytes that are no UTF-8 text, with what the file looks like."""
@@ -198,3 +228,32 @@ def parquet_numbers(source: Source, header: list[str], wanted, flags=()) -> Colu
             raise RecordingError(f"{source.label}: column {header[k]} holds {field.type}, expected numbers"
                                  f"{' (booleans only in ' + ', '.join(flags) + ')' if boolean and flags else ''}")
     return Columns(table.num_rows, lambda j: floats(table.column(j).cast(pa.float64())), wanted)
+
+
+def _stream(fh, label: str) -> bytes:
+    """A stream's bytes (fh, binary) read whole, refused (RecordingError) beyond MAX_STREAM_BYTES: an endless
+    or very long stream is not read until memory runs out."""
+    chunks, size = [], 0
+    while chunk := fh.read(CHUNK):
+        size += len(chunk)
+        if size > MAX_STREAM_BYTES:
+            raise RecordingError(f"{label}: a stream of more than {MAX_STREAM_BYTES // 2**20} MiB (or one that does "
+                                 "not end); a stream is read whole into memory: write the recording to a file and "
+                                 "give the file")
+        chunks.append(chunk)
+    return b"".join(chunks)
+
+
+def _data_end(fd: int, size: int) -> int:
+    """Where a file of size bytes ends but for its last hole (a sparse file's unwritten space, NUL when read):
+    found by SEEK_DATA and SEEK_HOLE where the system has them, else size."""
+    if not hasattr(os, "SEEK_DATA"):
+        return size
+    end, position = 0, 0
+    try:
+        while position < size:
+            position = os.lseek(fd, position, os.SEEK_DATA)
+            end = position = os.lseek(fd, position, os.SEEK_HOLE)
+    except OSError as exc:  # ENXIO: no data after position; another error: the system cannot say
+        return end if exc.errno == errno.ENXIO else size
+    return end

@@ -6,7 +6,10 @@
  * configuration (every Enumeration parameter's item and the parameter `latency` cycled through)
  * of an instance initialised and stepped a few times, or (bit 7) an instance only instantiated.
  * The state's header is made to agree with its data as anyone can make it (its configuration hash
- * and checksum recomputed), so that the bytes reach the checks of every field. Then, as an importer
+ * and checksum recomputed), so that the bytes reach the checks of every field; with bit 6 the
+ * forgery is a consistent one: the model's clocks are made to agree with its counts first (a
+ * motion's time with the grid cells drawn, the header's time with the steps taken), so a forged
+ * count near 2^64 passes every check that compares the two. Then, as an importer
  * would: fmi2DeSerializeFMUstate, fmi2SetFMUstate, ten fmi2DoSteps and fmi2GetReal of every
  * variable. A refused state must leave the instance as it was (its serialised state the same
  * bytes): anything else aborts, as the sanitizers (ASan, UBSan) do on a fault.
@@ -18,8 +21,16 @@
  *                                              tests/test_fmu_state.py
  *   fuzz_state_<Name> --write CASE FILE        a valid input of CASE (its serialised state) into FILE
  *   fuzz_state_<Name> SECONDS SEED FILE...     every FILE (inputs) run, then mutations of them (bytes
- *                                              flipped, fields set to edge values, cut short) for
- *                                              SECONDS; prints "runs N refused R taken T" */
+ *                                              flipped, fields set to edge values, cut short; half of
+ *                                              them consistent forgeries) for SECONDS; prints "runs N
+ *                                              refused R taken T". A run of one input longer than
+ *                                              CALL_LIMIT seconds ends the driver (SIGALRM): a hang
+ *                                              is a finding, as libFuzzer's -timeout makes it. */
+#if defined(__unix__) || defined(__APPLE__)
+#define _POSIX_C_SOURCE 200809L /* alarm */
+#include <unistd.h>
+#define HAVE_ALARM 1
+#endif
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -35,6 +46,8 @@
 #define WARM_UP 25 /* steps before the state is set */
 #define STEPS 10   /* steps after */
 #define CASE_HUMBLE 0x80 /* bit of the case byte: an instance only instantiated */
+#define CASE_AGREE 0x40  /* bit of the case byte: a consistent forgery (agree) */
+#define CALL_LIMIT 20    /* s: the longest run of one input the driver waits for */
 
 static void quiet(fmi2ComponentEnvironment environment, fmi2String name, fmi2Status status, fmi2String category,
                   fmi2String message, ...) {
@@ -98,10 +111,25 @@ static fmi2Byte *serialised(fmi2Component c, size_t *size) {
     return bytes;
 }
 
+/* a consistent forgery (CASE_AGREE): the model's clocks set from its counts in the state's data, the
+ * header's time with them, as a forger who knows the format would, so only the bounds on the counts
+ * themselves stand between a forged count and the loops it drives */
+static void agree(Fmi2Instance *view, Fmi2StateHeader *header) {
+    Model *model = view->state;
+#if defined(AF_MODEL_MotionProfile)
+    if (model->human) model->stream.t = (double)model->stream.k * model->stream.grid;
+    header->time = model->human ? model->stream.t : header->time;
+#elif defined(AF_MODEL_ImuSensor)
+    header->time = (double)model->k * model->step_size;
+#else
+    header->time = model->estimator.state.offset.t;
+#endif
+}
+
 /* the header of serialised bytes made to agree with their data and the FMU (its guid, which its
  * modelDescription.xml gives anyone), as an attacker would make it: a corpus written by another build
- * of the FMU still reaches the checks of the data */
-static void forge(unsigned char *bytes, size_t size) {
+ * of the FMU still reaches the checks of the data; consistent: a consistent forgery (agree) */
+static void forge(unsigned char *bytes, size_t size, int consistent) {
     Fmi2StateHeader header;
     if (size < sizeof header) return;
     memcpy(&header, bytes, sizeof header);
@@ -111,6 +139,7 @@ static void forge(unsigned char *bytes, size_t size) {
     memset(&view, 0, sizeof view);
     if (size - sizeof header == fmi2_data_size()) {
         fmi2_instance_bind(&view, bytes + sizeof header);
+        if (consistent) agree(&view, &header);
         header.configuration = fmi2_state_configuration(&view);
     }
     header.check = fmi2_state_checksum(bytes + sizeof header, size - sizeof header);
@@ -126,7 +155,7 @@ static int run_case(const unsigned char *data, size_t size) {
     unsigned char *bytes = malloc(n ? n : 1);
     if (!bytes) abort();
     memcpy(bytes, data + 1, n);
-    forge(bytes, n);
+    forge(bytes, n, data[0] & CASE_AGREE);
     fmi2Byte *before = serialised(c, &before_size);
     fmi2FMUstate state = NULL;
     int taken = fmi2DeSerializeFMUstate(c, (const fmi2Byte *)bytes, n, &state) == fmi2OK &&
@@ -323,6 +352,18 @@ static void set_field(unsigned char *bytes, size_t size, const Field *f, size_t 
     if (place + width <= size) memcpy(bytes + place, value, width);
 }
 
+/* run_case within CALL_LIMIT seconds: SIGALRM's default action ends the driver where it hangs */
+static int timed_case(const unsigned char *data, size_t size) {
+#ifdef HAVE_ALARM
+    alarm(CALL_LIMIT);
+#endif
+    int taken = run_case(data, size);
+#ifdef HAVE_ALARM
+    alarm(0);
+#endif
+    return taken;
+}
+
 static int fuzz(double seconds, unsigned long long seed, int n, char **paths) {
     unsigned char *inputs[64];
     size_t sizes[64];
@@ -343,7 +384,7 @@ static int fuzz(double seconds, unsigned long long seed, int n, char **paths) {
     }
     size_t at = state_offset();
     unsigned long runs = 0, taken = 0;
-    for (int i = 0; i < count; i++, runs++) taken += (unsigned long)run_case(inputs[i], sizes[i]);
+    for (int i = 0; i < count; i++, runs++) taken += (unsigned long)timed_case(inputs[i], sizes[i]);
     clock_t end = clock() + (clock_t)(seconds * CLOCKS_PER_SEC);
     while (clock() < end) {
         unsigned long long r = next(&seed);
@@ -365,7 +406,8 @@ static int fuzz(double seconds, unsigned long long seed, int n, char **paths) {
             if (r >> 40 & 1) size = next(&seed) % size;
             else bytes[0] = (unsigned char)next(&seed);
         }
-        taken += (unsigned long)run_case(bytes, size);
+        if (size > 0) bytes[0] = (unsigned char)(r >> 63 ? bytes[0] | CASE_AGREE : bytes[0] & ~CASE_AGREE);
+        taken += (unsigned long)timed_case(bytes, size);
         runs++;
         free(bytes);
     }

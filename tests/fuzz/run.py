@@ -2,7 +2,9 @@
 bounded time from the corpus tests/fuzz/corpus/<Model>, with the address and undefined-behaviour
 sanitizers: under libFuzzer where clang has it (CMake option AF_FUZZ), else (libfuzzer=False, or no
 clang) the targets' own driver built by the C compiler with AF_SANITIZE (seeded mutations: bytes
-flipped, fields set to edge values, inputs cut short).
+flipped, fields set to edge values, inputs cut short). Half the inputs are consistent forgeries (the
+case byte's bit 6: the models' clocks made to agree with their counts); each input has 20 s at most
+(libFuzzer's -timeout, the driver's CALL_LIMIT), so a hang is a finding.
 
     python -m tests.fuzz.run SECONDS [--driver]    SECONDS per model; exit 1 on a finding
 
@@ -12,6 +14,7 @@ an abort (a refused state that changed the instance)."""
 import os
 import re
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
@@ -85,7 +88,8 @@ def run_driver(binary: Path, model: str, seconds: float, seed: int = 1) -> Run:
     elapsed = time.monotonic() - start
     runs = re.search(r"runs (\d+)", proc.stdout)
     reports = [r for r in ("runtime error", "Sanitizer", "fuzz_state:") if r in proc.stderr]
-    findings = [proc.stderr[-3000:]] if proc.returncode != 0 or reports else []
+    hung = ["an input ran longer than the driver's CALL_LIMIT (SIGALRM)"] if proc.returncode == -signal.SIGALRM else []
+    findings = hung + ([proc.stderr[-3000:]] if proc.returncode != 0 or reports else [])
     return Run(model, int(runs.group(1)) if runs else 0, elapsed, findings)
 
 

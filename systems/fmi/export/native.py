@@ -4,7 +4,6 @@ the generated tables), its binary built by the project's CMake (CMakeLists.txt, 
 platform and any other (cmake/zig.cmake), the folder zipped."""
 from __future__ import annotations
 
-import os
 import subprocess
 import tempfile
 import zipfile
@@ -74,15 +73,15 @@ def build_binary(stage: Path, name: str, fmi: str, platform: str | None, build_d
 
 
 def zip_folder(folder: Path, path: Path) -> None:
-    """folder's files zipped into path (entries sorted, dated 1980-01-02 as the project's FMUs are),
-    replacing it at once."""
-    partial = path.with_name(f".{path.name}.{os.getpid()}.partial")
-    with zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as zf:
+    """folder's files zipped into path (entries sorted, dated 1980-01-02 as the project's FMUs are) by the
+    project's one writer (systems.recordings.output.replaced: complete or not at all)."""
+    from attitude_fmu.systems.recordings.output import replaced
+
+    with replaced(path) as fh, zipfile.ZipFile(fh, "w", zipfile.ZIP_DEFLATED) as zf:
         for file in sorted(p for p in folder.rglob("*") if p.is_file()):
             info = zipfile.ZipInfo(file.relative_to(folder).as_posix(), date_time=(1980, 1, 2, 0, 0, 0))
             info.compress_type, info.external_attr = zipfile.ZIP_DEFLATED, 0o644 << 16
             zf.writestr(info, file.read_bytes())
-    os.replace(partial, path)
 
 
 def write_native(path: Path, name: str, fmi: str, diagram, x0, step, description: str, platforms, options=(),

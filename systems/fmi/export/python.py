@@ -26,6 +26,7 @@ def write_python(path: Path, name: str, system, x0, step, fmi_version: str) -> P
     from pythonfmu.builder import FmuBuilder
 
     from attitude_fmu.systems.fmi.build import guard_binary, guarded
+    from attitude_fmu.systems.recordings.output import copy_file
 
     if fmi_version != "2.0":
         raise ValueError("backend='python' builds FMI 2.0 FMUs only (pythonfmu)")
@@ -42,6 +43,5 @@ def write_python(path: Path, name: str, system, x0, step, fmi_version: str) -> P
         built = FmuBuilder.build_FMU(script, dest=Path(tmp) / "out", project_files=[Path(tmp) / SYSTEM_FILE],
                                      needsExecutionTool="false", canGetAndSetFMUstate="true",
                                      canSerializeFMUstate="true")
-        Path(path).write_bytes(Path(built).read_bytes())
-    guarded(Path(path), guard_binary())
-    return Path(path)
+        guarded(Path(built), guard_binary())
+        return copy_file(built, path)
