@@ -48,19 +48,32 @@ def cmake_build(build_dir, targets=(), options=(), source=ROOT, quiet: bool = Fa
     """CMake's build of the clone at source in build_dir: configured first where it is not yet (with
     this Python, Ninja where there is one, the -D options), then the targets built (every one
     without). Raises subprocess.CalledProcessError (quiet: CMake's and the compiler's output kept
-    for its output instead of shown); returns build_dir."""
+    for its output instead of shown); returns build_dir. A configuration that fails is not kept (nor
+    one an earlier failure left half done): the next run configures afresh."""
     cmake, build_dir = _tool("cmake"), Path(build_dir)
     if cmake is None:
         raise FileNotFoundError("building a clone needs CMake: pip install cmake ninja")
     output = {"capture_output": True, "text": True} if quiet else {}
-    if not (build_dir / "CMakeCache.txt").is_file():
+    if not _configured(build_dir):
         ninja = _tool("ninja")
         generator = ["-G", "Ninja", f"-DCMAKE_MAKE_PROGRAM={ninja}"] if ninja else []
-        subprocess.run([cmake, "-S", str(source), "-B", str(build_dir), *generator,
-                        f"-DPython_EXECUTABLE={sys.executable}", *(f"-D{o}" for o in options)], check=True, **output)
+        (build_dir / "CMakeCache.txt").unlink(missing_ok=True)
+        try:
+            subprocess.run([cmake, "-S", str(source), "-B", str(build_dir), *generator,
+                            f"-DPython_EXECUTABLE={sys.executable}", *(f"-D{o}" for o in options)], check=True,
+                           **output)
+        except BaseException:  # a failure or a signal: no half-configured folder for the next run to trip on
+            (build_dir / "CMakeCache.txt").unlink(missing_ok=True)
+            raise
     subprocess.run([cmake, "--build", str(build_dir), *(a for t in targets for a in ("--target", t))], check=True,
                    **output)
     return build_dir
+
+
+def _configured(build_dir: Path) -> bool:
+    """Whether CMake's configuration of build_dir completed: its cache and its generator's build file."""
+    return (build_dir / "CMakeCache.txt").is_file() and any(
+        (build_dir / name).is_file() for name in ("build.ninja", "Makefile"))
 
 
 def project_version() -> str:
@@ -77,6 +90,11 @@ def build_clone(build_dir=ROOT / "build") -> None:
     a process may have the old one loaded."""
     from attitude_fmu.systems.recordings.output import copy_file
 
+    missing = [name for name in ("nanobind", "fmpy") if importlib.util.find_spec(name) is None]
+    if missing:
+        raise RuntimeError(f"building the clone needs {' and '.join(missing)} in this Python ({sys.executable}): "
+                           f"pip install {' '.join(missing)}; or let the installed package build them: python -m "
+                           "attitude_fmu.build_fmu")
     staged = Path(cmake_build(build_dir)) / "install"
     shutil.rmtree(staged, ignore_errors=True)
     subprocess.run([_tool("cmake"), "--install", str(build_dir), "--prefix", str(staged)], check=True)

@@ -206,6 +206,8 @@ def test_refusals_name_the_blocks(tmp_path):
                                         connections=[["second.z", "first.z"]])
     with pytest.raises(ExportError, match="'second'.*Python functions.*backend='python'"):
         export_fmu(python_block, tmp_path / "loop.fmu")
+    with pytest.raises(ExportError, match="^block 'second' \\(NonlinearIOSystem\\) has no C step"):  # alone, named
+        export_fmu(b, tmp_path / "second.fmu")
     c = estimator_system("wiener", dt=dt, name="est1")
     d = control.ss([], [], [], np.hstack([np.zeros((6, 3)), np.zeros((6, 4))]) + np.eye(6, 7), dt,
                    inputs=[f"ghat_{x}" for x in "xyz"] + [f"q_{x}" for x in "wxyz"],

@@ -238,3 +238,42 @@ def test_export_into_a_named_pipe_writes_the_fmu_through_it(tmp_path):
     copy.write_bytes(received["data"])
     with zipfile.ZipFile(copy) as zf:
         assert zf.testzip() is None and "modelDescription.xml" in zf.namelist()
+
+
+# build_fmu.py in a clone (issue 49, point 6)
+
+def test_build_fmu_in_a_clone_names_what_to_install_in_one_line(tmp_path):
+    """A clone's build_fmu.py in a Python without nanobind (what `pip install .` leaves): exit 2, one line
+    naming it, and no build folder begun."""
+    from tests.native import ROOT
+
+    script = ("import runpy, sys\n"
+              "sys.modules['nanobind'] = None  # pip install . built in an isolated Python that had it\n"
+              "path, sys.argv = sys.argv[1], ['build_fmu.py', *sys.argv[2:]]\n"
+              "runpy.run_path(path, run_name='__main__')\n")
+    before = (ROOT / "build").exists()
+    done = subprocess.run([sys.executable, "-c", script, str(ROOT / "build_fmu.py"), "--out", str(tmp_path / "out")],
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 2, done.stderr
+    assert done.stderr == (f"build_fmu: error: building the clone needs nanobind in this Python ({sys.executable}): "
+                           "pip install nanobind; or let the installed package build them: python -m "
+                           "attitude_fmu.build_fmu\n"), done.stderr
+    assert (ROOT / "build").exists() == before and not (tmp_path / "out").exists()
+
+
+def test_a_failed_configuration_is_not_left_for_the_next_run(tmp_path):
+    """CMake's configuration fails (here: the project says so): no cache is kept, so the next run configures
+    afresh instead of failing on a build file that was never written ("ninja: error: loading 'build.ninja'")."""
+    from attitude_fmu.build_fmu import cmake_build
+
+    source, build = tmp_path / "source", tmp_path / "build"
+    source.mkdir()
+    (source / "CMakeLists.txt").write_text("cmake_minimum_required(VERSION 3.15)\nproject(t LANGUAGES NONE)\n"
+                                           "message(FATAL_ERROR \"not today\")\n")
+    with pytest.raises(subprocess.CalledProcessError):
+        cmake_build(build, source=source, quiet=True)
+    assert not (build / "CMakeCache.txt").exists()
+    (source / "CMakeLists.txt").write_text("cmake_minimum_required(VERSION 3.15)\nproject(t LANGUAGES NONE)\n"
+                                           "add_custom_target(done ALL COMMAND ${CMAKE_COMMAND} -E touch done)\n")
+    cmake_build(build, source=source, quiet=True)
+    assert (build / "done").is_file()

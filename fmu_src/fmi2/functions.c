@@ -2,6 +2,7 @@
  * instance's state allows the call (instance.h: fmi2_enter), does it, and returns the status the
  * standard gives it, raised to what the call logged (fmi2_leave). A call without an instance
  * (NULL) returns fmi2Error: there is no logger to tell. */
+#include <math.h>
 #include <string.h>
 
 #include "fmi2_model.h"
@@ -59,8 +60,13 @@ fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nC
 
 fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance,
                                fmi2Real startTime, fmi2Boolean stopTimeDefined, fmi2Real stopTime) {
-    (void)toleranceDefined, (void)tolerance, (void)startTime, (void)stopTimeDefined, (void)stopTime;
+    (void)toleranceDefined, (void)tolerance, (void)stopTimeDefined, (void)stopTime;
     INSTANCE(c, "fmi2SetupExperiment", FMI2_IN(FMI2_INSTANTIATED));
+    if (!isfinite(startTime)) {
+        fmi2_log(instance, fmi2Error, "fmi2SetupExperiment: the start time %g s is not finite", startTime);
+        return fmi2_leave(instance, fmi2Error);
+    }
+    instance->start_time = startTime;
     return fmi2_leave(instance, fmi2OK);
 }
 

@@ -98,7 +98,11 @@ fmi3Status fmi3EnterInitializationMode(fmi3Instance c, fmi3Boolean toleranceDefi
                                        fmi3Float64 startTime, fmi3Boolean stopTimeDefined, fmi3Float64 stopTime) {
     (void)toleranceDefined, (void)tolerance, (void)stopTimeDefined, (void)stopTime;
     INSTANCE(c, "fmi3EnterInitializationMode", FMI2_IN(FMI2_INSTANTIATED));
-    instance->time = startTime;
+    if (!isfinite(startTime)) {
+        fmi2_log(instance, fmi2Error, "fmi3EnterInitializationMode: the start time %g s is not finite", startTime);
+        return leave(instance, fmi2Error);
+    }
+    instance->time = instance->start_time = startTime;
     instance->phase = FMI2_INITIALIZATION_MODE;
     return leave(instance, fmi2OK);
 }

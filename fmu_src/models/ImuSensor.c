@@ -2,8 +2,12 @@
  * generated from systems/fmi/interface/simulation_variables.py) onto the simulation's sensor model (sensor.h),
  * delay line (delay_line.h) and noise streams (noise.h): step k draws sample k of the
  * streams SENSOR and MAGNETOMETER of `seed`, as ImuModel.apply and apply_mag draw them.
+ * With a latency the first step's size is the sensor's sample time, and later steps run on its grid
+ * from the start time (fmi2_samples): the samples a step reaches, its inputs held; none (a master's
+ * shortfall of picoseconds, half a sample) holds the outputs; several run in turn. Without one, each
+ * step is a sample of its own length.
  * The pythonfmu ImuSensor (fmu_src/ImuSensor.py) runs the same C core with the same checks,
- * messages and statuses. */
+ * messages and statuses, but for the grid: with a latency it refuses a step of another size. */
 #include <math.h>
 #include <stdint.h>
 #include <string.h>
@@ -13,9 +17,9 @@
 #include "delay_line.h"
 #include "noise.h"
 #include "sensor.h"
-#include "stages/timing.h"
 
 #define MESSAGE_SIZE 512
+#define MAX_SAMPLES 1048576.0 /* samples one step may run (a bound on the work of one call) */
 
 typedef struct {
     ImuParams params;
@@ -63,31 +67,13 @@ static int validate(const void *state, const void *configured, char *message, si
     return delay_validate(&model->delay, model->params.latency, 1.0 / model->step_size, message, size);
 }
 
-static fmi2Status step(Fmi2Instance *instance, fmi2Real t, fmi2Real h) {
-    Model *model = instance->state;
+/* one sample of h (s) of the inputs as they are: the outputs, the delay line stepped (a latency) */
+static void sample(Fmi2Instance *instance, Model *model, double h) {
     fmi2Real *r = instance->reals;
     double signals[DELAY_WIDTH], late[DELAY_WIDTH], noise[SENSOR_WIDTH], mag_noise[MAGNETOMETER_WIDTH];
-    if (!isfinite(1.0 / h) || !isfinite(t + h)) { /* a sample rate or an end beyond the arithmetic's range */
-        char a[FLOAT_REPR_SIZE], b[FLOAT_REPR_SIZE];
-        fmi2_log(instance, fmi2Error, "a step of %s s to %s s overflows the sensor's arithmetic", float_repr(h, a),
-                 float_repr(t + h, b));
-        return fmi2Error;
-    }
     for (int i = 0; i < 3; i++) signals[i] = r[REAL_omega_x + i], signals[3 + i] = r[REAL_f_x + i];
     const double *measured = signals;
     if (model->params.latency) {
-        char message[MESSAGE_SIZE], a[FLOAT_REPR_SIZE], b[FLOAT_REPR_SIZE];
-        if (model->k == 0) {
-            if (delay_init(&model->delay, model->params.latency, 1.0 / h, signals, message, sizeof message) != 0) {
-                fmi2_log(instance, fmi2Error, "%s", message);
-                return fmi2Error;
-            }
-            model->step_size = h;
-        } else if (!same_step(h, model->step_size)) {
-            fmi2_log(instance, fmi2Error, "latency needs a fixed step: got %s s after %s s", float_repr(h, a),
-                     float_repr(model->step_size, b));
-            return fmi2Error;
-        }
         delay_step(&model->delay, signals, late);
         measured = late;
     }
@@ -96,6 +82,40 @@ static fmi2Status step(Fmi2Instance *instance, fmi2Real t, fmi2Real h) {
     noise_normals(model->seed, MAGNETOMETER, model->k, MAGNETOMETER_WIDTH, mag_noise);
     imu_measure_mag(&model->params, &r[REAL_m_x], mag_noise, 1.0 / h, &r[REAL_mag_x]);
     model->k++;
+}
+
+static fmi2Status step(Fmi2Instance *instance, fmi2Real t, fmi2Real h) {
+    Model *model = instance->state;
+    char a[FLOAT_REPR_SIZE], b[FLOAT_REPR_SIZE], message[MESSAGE_SIZE];
+    if (!isfinite(1.0 / h) || !isfinite(t + h)) { /* a sample rate or an end beyond the arithmetic's range */
+        fmi2_log(instance, fmi2Error, "a step of %s s to %s s overflows the sensor's arithmetic", float_repr(h, a),
+                 float_repr(t + h, b));
+        return fmi2Error;
+    }
+    if (!model->params.latency) {
+        sample(instance, model, h);
+        return fmi2OK;
+    }
+    if (model->k == 0) { /* the first step: the sample time, the delay line filled with the inputs */
+        double signals[DELAY_WIDTH];
+        for (int i = 0; i < 3; i++)
+            signals[i] = instance->reals[REAL_omega_x + i], signals[3 + i] = instance->reals[REAL_f_x + i];
+        if (delay_init(&model->delay, model->params.latency, 1.0 / h, signals, message, sizeof message) != 0) {
+            fmi2_log(instance, fmi2Error, "%s", message);
+            return fmi2Error;
+        }
+        model->step_size = h;
+        sample(instance, model, h);
+        return fmi2OK;
+    }
+    const double n = fmi2_samples(instance, model->step_size, t, h);
+    if (n > MAX_SAMPLES) {
+        fmi2_log(instance, fmi2Error, "a step of %s s reaches %.0f samples of the sensor's sample time %s s (its "
+                 "first step's); one step runs %.0f at most", float_repr(h, a), n, float_repr(model->step_size, b),
+                 MAX_SAMPLES);
+        return fmi2Error;
+    }
+    for (double k = 0.0; k < n; k++) sample(instance, model, model->step_size);
     return fmi2OK;
 }
 

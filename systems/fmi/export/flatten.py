@@ -112,7 +112,7 @@ def _leaf(diagram: Diagram, system, path: str) -> list[Expression]:
 
     lti, step = _state_space(system), c_step(system)
     if lti is None and step is None:
-        raise ExportError(f"block {path!r} ({type(system).__name__}) has no C step: its update and output are "
+        raise ExportError(f"block {path or system.name!r} ({type(system).__name__}) has no C step: its update and output are "
                           f"Python functions; export it with backend='python' (the FMU then needs a Python with "
                           f"attitude_fmu where it runs)")
     block = Block(path, lti if lti is not None else system, step, lti, len(diagram.inputs), diagram.n_signals,

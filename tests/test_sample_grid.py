@@ -1,0 +1,141 @@
+"""FMUs with a sample time run on its grid (issue 49, point 1): an exported discrete diagram and the native
+ImuSensor with a latency, FMI 2.0 and 3.0, under a master that steps as strict masters do: time summed
+step by step (60 s of 0.01 s ends at 59.99999999999663) and a final step of the shortfall, which must return
+fmi2OK and leave the outputs as they were; steps of Ts/2 and 3·Ts give the outputs of the Ts grid at the
+instants they share (inputs constant, so held inputs are the same inputs)."""
+import control
+import numpy as np
+import pytest
+from fmpy import extract, read_model_description
+from fmpy.fmi2 import FMU2Slave
+from fmpy.fmi3 import FMU3Slave
+
+from attitude_fmu.systems.fmi.export.api import export_fmu
+from tests import native
+
+TS = 0.01
+STOP = 60.0
+BUILD = ("AF_WERROR=ON", *(("AF_SANITIZE=ON",) if native.sanitized_build() is not None else ()))
+
+
+class Master:
+    """One FMU (FMI 2.0 or 3.0) under fmpy, its Real inputs set before each step, its Real outputs read after;
+    fmpy raises on a status of fmi2Error or worse, so a run that returns took every step."""
+
+    def __init__(self, path, parameters=None):
+        self.md = read_model_description(str(path))
+        self.variables = {v.name: v for v in self.md.modelVariables}
+        self.unzipdir = extract(str(path))
+        kind = FMU3Slave if self.md.fmiVersion.startswith("3") else FMU2Slave
+        self.fmu = kind(guid=self.md.guid, unzipDirectory=self.unzipdir,
+                        modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName="grid")
+        self.fmi3 = kind is FMU3Slave
+        self.fmu.instantiate()
+        if self.fmi3:
+            self.fmu.enterInitializationMode(startTime=0.0)
+        else:
+            self.fmu.setupExperiment(startTime=0.0)
+            self.fmu.enterInitializationMode()
+        for name, value in (parameters or {}).items():
+            self._set([name], [value])
+        self.fmu.exitInitializationMode()
+        self.outputs = [v.name for v in self.md.modelVariables if v.causality == "output"]
+
+    def _set(self, names, values):
+        refs = [self.variables[n].valueReference for n in names]
+        (self.fmu.setFloat64 if self.fmi3 else self.fmu.setReal)(refs, [float(v) for v in values])
+
+    def step(self, t: float, h: float, inputs: dict) -> np.ndarray:
+        if inputs:
+            self._set(list(inputs), list(inputs.values()))
+        self.fmu.doStep(t, h)
+        refs = [self.variables[n].valueReference for n in self.outputs]
+        return np.array((self.fmu.getFloat64 if self.fmi3 else self.fmu.getReal)(refs))
+
+    def close(self):
+        self.fmu.terminate()
+        self.fmu.freeInstance()
+
+
+def summed_run(path, parameters, inputs, first: float | None = None):
+    """The strict master's run to STOP: steps of TS summed into t (after a first step of first, where given),
+    then the shortfall; (outputs before the shortfall step, after it, the shortfall)."""
+    master = Master(path, parameters)
+    t, before = 0.0, None
+    if first is not None:
+        before = master.step(t, first, inputs)
+        t += first
+    while t + TS <= STOP:
+        before = master.step(t, TS, inputs)
+        t += TS
+    shortfall = STOP - t
+    assert 0.0 < shortfall < 1e-9, shortfall  # what OMSimulator's sum leaves
+    after = master.step(t, shortfall, inputs)
+    master.close()
+    return before, after, shortfall
+
+
+def grid_outputs(path, parameters, inputs, h: float, steps: int, first: float | None = None) -> np.ndarray:
+    """The outputs after each of steps steps of h (after a first step of first, where given), time summed."""
+    master = Master(path, parameters)
+    t, rows = 0.0, []
+    if first is not None:
+        rows.append(master.step(t, first, inputs))
+        t += first
+    for _ in range(steps):
+        rows.append(master.step(t, h, inputs))
+        t += h
+    master.close()
+    return np.array(rows)
+
+
+def _shares_the_grid(path, parameters, inputs, first=None):
+    """Steps of TS/2 and 3·TS give the TS run's outputs at the instants they share."""
+    offset = 0 if first is None else 1
+    base = grid_outputs(path, parameters, inputs, TS, 60, first)
+    half = grid_outputs(path, parameters, inputs, TS / 2, 120, first)
+    triple = grid_outputs(path, parameters, inputs, 3 * TS, 20, first)
+    np.testing.assert_allclose(half[offset + 1::2], base[offset:], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(triple[offset:], base[offset + 2::3], rtol=0, atol=1e-12)
+    assert not np.allclose(base[offset:offset + 10], base[offset + 10:offset + 20])  # the outputs move
+
+
+@pytest.fixture(scope="module", params=["2.0", "3.0"])
+def diagram_fmu(request, tmp_path_factory):
+    """A discrete diagram of two states exported natively, and its constant input."""
+    system = control.ss([[0.9, 0.1], [0.0, 0.8]], [[1.0], [0.5]], [[1.0, -1.0]], [[0.2]], TS, name="plant")
+    path = tmp_path_factory.mktemp("grid") / f"plant{request.param[0]}.fmu"
+    export_fmu(system, path, fmi_version=request.param, cmake_options=BUILD)
+    return path, {"u[0]": 1.0}
+
+
+def test_an_exported_diagram_takes_the_shortfall_step_and_holds(diagram_fmu):
+    path, inputs = diagram_fmu
+    before, after, _ = summed_run(path, {}, inputs)
+    np.testing.assert_allclose(after, before, rtol=0, atol=1e-12)
+
+
+def test_an_exported_diagram_runs_the_samples_its_steps_reach(diagram_fmu):
+    path, inputs = diagram_fmu
+    _shares_the_grid(path, {}, inputs)
+
+
+@pytest.fixture(scope="module", params=["native", "native/fmi3"])
+def late_sensor(request, fmu_dir):
+    """The native ImuSensor (FMI 2.0, 3.0) with a latency and noise (each sample draws its own), and inputs
+    of a constant turn."""
+    inputs = {"omega_x": 0.3, "omega_y": -0.2, "omega_z": 0.1, "f_x": 0.5, "f_y": -0.4, "f_z": 9.8}
+    return fmu_dir / request.param / "ImuSensor.fmu", {"latency": 0.013, "delta_n": 0.01, "acc_noise": 0.05,
+                                                          "mag_noise": 0.5}, inputs
+
+
+def test_a_late_sensor_takes_the_shortfall_step_and_holds(late_sensor):
+    path, parameters, inputs = late_sensor
+    before, after, _ = summed_run(path, parameters, inputs)
+    np.testing.assert_allclose(after, before, rtol=0, atol=1e-12)
+
+
+def test_a_late_sensor_runs_the_samples_its_steps_reach(late_sensor):
+    """Its first step (TS) sets the sample time; then steps of TS/2 and 3·TS follow the TS grid."""
+    path, parameters, inputs = late_sensor
+    _shares_the_grid(path, parameters, inputs, first=TS)
