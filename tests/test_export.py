@@ -336,22 +336,25 @@ def test_fmu_states_come_back_and_forged_ones_are_refused(tmp_path):
     fmu.freeInstance()
 
 
-@pytest.mark.parametrize("fmi", ["2.0", "3.0"])
-def test_the_matrices_are_parameters_set_before_initialisation(tmp_path, fmi):
-    """A state space's A, B, C, D: FMI 2.0 scalars A[i,j], FMI 3.0 arrays with their dimensions, both with
-    the exported values as start; set before initialisation, the FMU steps the state space they make."""
+@pytest.mark.parametrize("kind", ["2.0", "3.0", "3.0 scalar"])
+def test_the_matrices_are_parameters_set_before_initialisation(tmp_path, kind):
+    """A state space's A, B, C, D: FMI 2.0 scalars A[i,j], FMI 3.0 arrays with their dimensions (or scalars
+    A[i,j] with scalar_parameters, for OMSimulator), each with the exported values as start; set before
+    initialisation, the FMU steps the state space they make."""
     from fmpy.fmi3 import FMU3Slave
 
     dt = 0.05
+    fmi, scalar = kind.split()[0], kind != "3.0"
     system = stable_discrete(11, 3, 2, 2, True, dt)
-    path = export(system, tmp_path / "random.fmu", fmi_version=fmi)
+    path = export(system, tmp_path / "random.fmu", fmi_version=fmi, scalar_parameters=kind == "3.0 scalar")
     md = read_model_description(str(path))
     variables = {v.name: v for v in md.modelVariables}
-    if fmi == "3.0":
+    if not scalar:
         assert [int(d.start) for d in variables["A"].dimensions] == [3, 3]
         assert "A[0,0]" not in variables
     else:
         assert float(variables["A[1,2]"].start) == system.A[1, 2] and "A" not in variables
+        assert not any(v.dimensions for v in md.modelVariables) and validate_fmu(str(path)) == []
     other = stable_discrete(12, 3, 2, 2, True, dt)
     slave = (FMU3Slave if fmi == "3.0" else FMU2Slave)(
         guid=md.instantiationToken if fmi == "3.0" else md.guid, unzipDirectory=extract(str(path)),
@@ -360,24 +363,40 @@ def test_the_matrices_are_parameters_set_before_initialisation(tmp_path, fmi):
     if fmi == "2.0":
         slave.setupExperiment(startTime=0.0)
     slave.enterInitializationMode()
+    set_real, get_real = (slave.setFloat64, slave.getFloat64) if fmi == "3.0" else (slave.setReal, slave.getReal)
     for matrix in "ABCD":
         values = np.asarray(getattr(other, matrix))
-        if fmi == "3.0":
+        if not scalar:
             slave.setFloat64([variables[matrix].valueReference], list(values.ravel()))  # nValues: its size
         else:
-            slave.setReal([variables[f"{matrix}[{i},{j}]"].valueReference for i in range(values.shape[0])
-                           for j in range(values.shape[1])], list(values.ravel()))
+            set_real([variables[f"{matrix}[{i},{j}]"].valueReference for i in range(values.shape[0])
+                      for j in range(values.shape[1])], list(values.ravel()))
     slave.exitInitializationMode()
-    set_real, get_real = (slave.setFloat64, slave.getFloat64) if fmi == "3.0" else (slave.setReal, slave.getReal)
     u = np.random.default_rng(13).normal(size=(30, 2))
     out = []
     for k, row in enumerate(u):
         set_real([variables[n].valueReference for n in system.input_labels], list(row))
         slave.doStep(k * dt, dt)
         out.append(get_real([variables[n].valueReference for n in system.output_labels]))
-    if fmi == "3.0":
+    if not scalar:
         got = slave.getFloat64([variables["B"].valueReference], nValues=6)
         assert np.array_equal(got, np.asarray(other.B).ravel())
     slave.terminate()
     slave.freeInstance()
     np.testing.assert_allclose(np.array(out), reference(other, u, dt), rtol=0, atol=TOLERANCE)
+
+
+def test_command_line_writes_scalar_parameters_in_fmi_3_0(tmp_path):
+    """attitude export --fmi-version 3.0 --scalar-parameters: A[0,0] and its kin, no array, a valid FMU."""
+    source = tmp_path / "plant.py"
+    source.write_text("import control\n\nplant = control.ss([[0.5, 0.1], [0.0, 0.3]], [[1.0], [0.0]], [[2.0, 1.0]], "
+                      "[[0.0]], 0.1, name='plant')\n")
+    out = tmp_path / "plant.fmu"
+    done = subprocess.run([sys.executable, "-m", "attitude_fmu.systems.cli.commands", "export", f"{source}:plant",
+                           "--out", str(out), "--fmi-version", "3.0", "--scalar-parameters"], capture_output=True,
+                          text=True)
+    assert done.returncode == 0, done.stderr
+    md = read_model_description(str(out))
+    names = {v.name for v in md.modelVariables}
+    assert {"A[0,0]", "A[0,1]", "A[1,0]", "A[1,1]", "B[0,0]", "C[0,1]", "D[0,0]"} <= names and "A" not in names
+    assert validate_fmu(str(out)) == []

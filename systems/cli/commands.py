@@ -385,6 +385,9 @@ def build_parser() -> argparse.ArgumentParser:
     ex.add_argument("--backend", choices=("native", "python"), default="native",
                     help="native: C, no Python where it runs (default); python: pythonfmu, any discrete system, "
                          "Python functions included (needs a Python with attitude_fmu where it runs)")
+    ex.add_argument("--scalar-parameters", action="store_true",
+                    help="FMI 3.0: one scalar parameter per matrix entry (A[0,1]) instead of an array per matrix, for "
+                         "importers that read every Float64 as a scalar (OMSimulator); FMI 2.0 has scalars only")
 
     add_simulate_parser(sub, _number, _param)
 
@@ -852,7 +855,8 @@ def cmd_export(args) -> int:
         system, x0 = load_system(args.system)
         path = export_fmu(system, args.out, x0=x0, step=args.step, fmi_version=args.fmi_version,
                           platforms=args.platforms, name=args.name, backend=args.backend,
-                          log=lambda m: print(f"attitude: {m}", file=sys.stderr))
+                          log=lambda m: print(f"attitude: {m}", file=sys.stderr),
+                          scalar_parameters=args.scalar_parameters)
     print(path)
     return 0
 

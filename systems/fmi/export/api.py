@@ -29,7 +29,7 @@ def _model_name(system, name: str | None) -> str:
 
 def export_fmu(system, path, *, x0=None, step: float | None = None, fmi_version: str = "2.0",
                platforms: str = "host", name: str | None = None, backend: str = "native",
-               cmake_options=(), log=lambda message: None) -> Path:
+               cmake_options=(), log=lambda message: None, scalar_parameters: bool = False) -> Path:
     """system (a python-control system) as a co-simulation FMU written to path; returns its path.
 
     system: a control.StateSpace or TransferFunction (SISO or MIMO; discrete ones step at their dt,
@@ -52,7 +52,11 @@ def export_fmu(system, path, *, x0=None, step: float | None = None, fmi_version:
     system's name); backend: "native" (C, no Python at run time) or "python" (pythonfmu: any discrete
     system, Python functions included; the FMU needs a Python with attitude_fmu and control where it
     runs); cmake_options: more -D options of the native build (NAME=VALUE: AF_WERROR=ON, warnings as
-    errors; AF_SANITIZE=ON, the address and undefined-behaviour sanitizers); log: progress messages.
+    errors; AF_SANITIZE=ON, the address and undefined-behaviour sanitizers); log: progress messages;
+    scalar_parameters: in FMI 3.0 too, one scalar parameter per matrix entry (A[0,1]) instead of an array per
+    matrix, for importers that read every Float64 variable as a scalar (OMSimulator's result file refuses
+    an array parameter: "fmi3GetFloat64: 1 values for 1 value references, which hold 9"); FMI 2.0 has
+    scalars only.
     ExportError names a block that cannot be exported natively (a Python-function block, an
     algebraic loop) and why; ValueError for bad arguments and for names that cannot go into the FMU's
     files as they are (systems.fmi.interface.escaping): a signal label outside FMI's structured naming
@@ -94,7 +98,7 @@ def export_fmu(system, path, *, x0=None, step: float | None = None, fmi_version:
                    f"block(s) in C ({', '.join(sorted({b.kind for b in diagram.blocks}))}), "
                    + (f"sample time {diagram.dt!r} s" if diagram.dt else "continuous, held by zero-order hold"))
     return write_native(path, model, fmi_version, diagram, x0, step or diagram.dt or 0.01, description,
-                        parse_platforms(platforms), tuple(cmake_options), log)
+                        parse_platforms(platforms), tuple(cmake_options), log, scalar_parameters)
 
 
 __all__ = ["ExportError", "export_fmu"]

@@ -42,15 +42,16 @@ def source_files(fmi: str) -> dict[str, bytes]:
     return files
 
 
-def stage_files(name: str, fmi: str, diagram, x0, step: float | None, description: str) -> dict[str, bytes]:
+def stage_files(name: str, fmi: str, diagram, x0, step: float | None, description: str,
+                scalar_parameters: bool = False) -> dict[str, bytes]:
     """The FMU's files but its binaries, by their path in it (systems/fmi/interface/generate.py's generated_files over
-    the diagram's variables and tables)."""
+    the diagram's variables, scalar ones with scalar_parameters, and tables)."""
     from attitude_fmu.build_fmu import project_version
     from attitude_fmu.systems.fmi.interface.documentation import EXPORTED
     from attitude_fmu.systems.fmi.interface.generate import NativeModel, generated_files
     from attitude_fmu.systems.fmi.export.tables import tables_header, variables
 
-    table, first = variables(diagram, fmi)
+    table, first = variables(diagram, fmi, scalar_parameters)
     sources = source_files(fmi)
     sources["diagram_tables.h"] = tables_header(name, diagram, first, x0).encode("ascii")
     return generated_files(name, fmi, project_version(), sources, NativeModel(lambda: table, description, EXPORTED),
@@ -85,15 +86,16 @@ def zip_folder(folder: Path, path: Path) -> None:
 
 
 def write_native(path: Path, name: str, fmi: str, diagram, x0, step, description: str, platforms, options=(),
-                 log=lambda message: None) -> Path:
+                 log=lambda message: None, scalar_parameters: bool = False) -> Path:
     """The native FMU of the diagram written to path, with the binaries of this platform and the platforms
-    (FMI 3.0 tuples; FMI 2.0: those with an FMI 2.0 folder), each built with the -D options."""
+    (FMI 3.0 tuples; FMI 2.0: those with an FMI 2.0 folder), each built with the -D options; its matrices
+    scalar parameters in FMI 3.0 too with scalar_parameters."""
     from attitude_fmu.systems.fmi.interface.generate import write_stage
     from attitude_fmu.systems.fmi.platforms import LIBRARY_SUFFIXES, PLATFORMS
 
     with tempfile.TemporaryDirectory(prefix="attitude_fmu_export_") as tmp:
         stage = Path(tmp) / "stage"
-        write_stage(stage, stage_files(name, fmi, diagram, x0, step, description))
+        write_stage(stage, stage_files(name, fmi, diagram, x0, step, description, scalar_parameters))
         targets = [None] + [p for p in platforms if fmi == "3.0" or PLATFORMS[p][1] is not None]
         for platform in targets:
             log(f"{Path(path).name} (model {name}): building its binary for {platform or 'this platform'}")

@@ -25,9 +25,10 @@ def signal_unit(label: str) -> str | None:
     return UNIT_STEMS.get(stem)
 
 
-def variables(diagram, fmi: str = "2.0") -> tuple[list, dict[int, int]]:
+def variables(diagram, fmi: str = "2.0", scalar_parameters: bool = False) -> tuple[list, dict[int, int]]:
     """(the FMU's variables: the diagram's inputs, its outputs, then each state space's matrices as
-    parameters, FMI 2.0: one scalar each (A[0,0], …), FMI 3.0: an array each (A, its Dimensions);
+    parameters, FMI 2.0 (or scalar_parameters): one scalar each (A[0,0], …), FMI 3.0: an array each (A, its
+    Dimensions);
     the value reference of each state-space block's first matrix element, by block index).
     ValueError where two variables would have the same name (FMI 3.0: time included), or a name is no
     FMI variable name (escaping.fmi_name)."""
@@ -51,10 +52,11 @@ def variables(diagram, fmi: str = "2.0") -> tuple[list, dict[int, int]]:
             values = np.asarray(getattr(block.lti, matrix), dtype=float)
             values = values.reshape(shape) if values.size else np.zeros(shape)
             description = f"{kind} state-space matrix {matrix} of {block.path or system.name}"
-            if fmi == "3.0" and values.size:
-                table.add(f"{prefix}{matrix}", REAL, PAR, "fixed", tuple(map(float, values.ravel())),
-                          f"{description}, {shape[0]}×{shape[1]}, row-major", dimensions=shape)
-            elif fmi != "3.0":
+            if fmi == "3.0" and not scalar_parameters:
+                if values.size:
+                    table.add(f"{prefix}{matrix}", REAL, PAR, "fixed", tuple(map(float, values.ravel())),
+                              f"{description}, {shape[0]}×{shape[1]}, row-major", dimensions=shape)
+            else:
                 for name, value in zip(element_names(f"{prefix}{matrix}", shape), values.ravel()):
                     table.add(name, REAL, PAR, "fixed", float(value), description)
     names = [v.name for v in table] + (["time"] if fmi == "3.0" else [])  # FMI 3.0's independent variable
