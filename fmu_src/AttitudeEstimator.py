@@ -2,7 +2,9 @@
 
 Each doStep(t, h) takes gyr (mean rate over (t, t+h], or with gyr_samples "point" the
 rate at t+h) and acc, mag at t+h, and steps the
-same pipeline as `attitude estimate` (blocks.pipeline.online.OnlineEstimator). The tuning
+same pipeline as `attitude estimate` (blocks.pipeline.online.OnlineEstimator) on the grid of its
+sample time Ts from the start time (blocks.stages.timing.grid_samples): the samples the step reaches,
+its inputs held; none (half a sample, a master's final shortfall of picoseconds) holds the estimate. The tuning
 parameters are those of every method and of the gyro-offset and heading estimators
 (blocks.pipeline.causal). Each starts at its default, so an importer shows the values the
 FMU runs with; one whose default is derived from others, or differs between the methods
@@ -16,7 +18,8 @@ from __future__ import annotations
 import math
 
 from attitude_fmu.blocks.pipeline.causal import valid_sample
-from attitude_fmu.blocks.pipeline.online import OnlineEstimator, same_step
+from attitude_fmu.blocks.pipeline.online import OnlineEstimator
+from attitude_fmu.blocks.stages.timing import GRID_MAX_SAMPLES, GRID_TOLERANCE, grid_samples
 from attitude_fmu.fmu_src.fmu_support import Fmi2Status, ProjectSlave
 from attitude_fmu.systems.fmi.interface.variables import attitude_estimator, tuning_parameters
 
@@ -31,13 +34,16 @@ def overrides(values) -> dict:
 class AttitudeEstimator(ProjectSlave):
     author = "attitude-fmu"
     description = "IMU attitude estimator (Rizun's optimal Wiener filter and peers); gravity up, ENU, q sensor->earth"
-    internal_state = ("estimator", "_noted_step")
+    internal_state = ("estimator",)
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
         self.register_table(attitude_estimator())
         self.estimator = None
-        self._noted_step = False
+        self.start_time = 0.0  # where the sample grid begins (fmi2SetupExperiment)
+
+    def setup_experiment(self, start_time, stop_time=None, tolerance=None):
+        self.start_time = float(start_time)
 
     def initialise(self):
         if not (math.isfinite(self.Ts) and self.Ts > 0):
@@ -57,14 +63,20 @@ class AttitudeEstimator(ProjectSlave):
             return self.refuse_step()
         if self.estimator is None:
             return self.fail("doStep before initialisation")
-        if not self._noted_step and not same_step(step_size, self.Ts):
-            self._noted_step = True  # a master with variable steps would log every one
-            self.log(f"communication step {step_size:g} s differs from Ts = {self.Ts:g} s: filter re-discretised "
-                     "for it (and, without further notes, for every other step size)", Fmi2Status.ok)
+        Ts, start = self.Ts, self.start_time
+        n = grid_samples(start, Ts, current_time, step_size)
+        if n > GRID_MAX_SAMPLES:
+            return self.fail(f"a step of {step_size!r} s reaches {n:.0f} samples of Ts = {Ts!r} s; one step runs "
+                             f"{GRID_MAX_SAMPLES:.0f} at most: the estimate held")
+        first = start + math.floor((current_time - start) / Ts + GRID_TOLERANCE) * Ts
+        return all(self._sample(first + k * Ts) for k in range(int(n)))
+
+    def _sample(self, t: float) -> bool:
+        """One sample of Ts at t (s) on the inputs as they are; False where it failed (fmi2Error)."""
         gyr = (self.gyr_x, self.gyr_y, self.gyr_z)
         acc = (self.acc_x, self.acc_y, self.acc_z)
         try:
-            self.valid = self.estimator.step(gyr, acc, step_size, (self.mag_x, self.mag_y, self.mag_z))
+            self.valid = self.estimator.step(gyr, acc, self.Ts, (self.mag_x, self.mag_y, self.mag_z))
         except ValueError as exc:
             return self.fail(str(exc))
         if self.valid:
@@ -77,5 +89,5 @@ class AttitudeEstimator(ProjectSlave):
             self.mag_delay_used = est.mag_delay
         elif not valid_sample(gyr, acc):
             what = "input beyond every IMU's range" if all(map(math.isfinite, gyr + acc)) else "non-finite input"
-            self.log(f"t={current_time:g}: {what}; estimate held", Fmi2Status.warning)
+            self.log(f"t={t:g}: {what}; estimate held", Fmi2Status.warning)
         return True

@@ -24,7 +24,7 @@ from attitude_fmu.blocks.errors import inclination_error, rms
 from attitude_fmu.blocks.methods.registry import METHODS
 from attitude_fmu.blocks.pipeline.batch import estimate
 from attitude_fmu.blocks.pipeline.online import OnlineEstimator
-from attitude_fmu.blocks.stages.timing import STEP_TOLERANCE
+from attitude_fmu.blocks.stages.timing import STEP_TOLERANCE, grid_samples
 from attitude_fmu.systems.fmi.build import (
     FINGERPRINT,
     FMU_NAMES,
@@ -338,29 +338,32 @@ def test_instances_in_one_process_stay_independent(fmu_dir, recording):
     assert np.abs(out_b[:, :4] - ref_b.quat).max() < 1e-9
 
 
-def test_changed_step_size_is_rediscretised_and_logged(fmu_dir, recording, capsys):
-    gyr, acc = recording
-    runner = _estimator(fmu_dir)
-    data = np.hstack([gyr, acc])[:200]
-    out = np.array([runner.step(row, 0.01 if k < 100 else 0.02)[0] for k, row in enumerate(data)])
-    runner.close()
-    assert capsys.readouterr().out.count("differs from Ts") == 1
-    # the same as the batch path over both halves, each at its own rate, carried across
-    first = estimate(gyr[:100], acc[:100], 100.0, gyro_offset=False)
-    online = OnlineEstimator(gyro_offset=False)
-    expected = []
-    for k, row in enumerate(data):
-        online.step(row[:3], row[3:], 0.01 if k < 100 else 0.02)
-        expected.append(online.quat)
-    assert np.abs(out[:100, :4] - first.quat).max() < 1e-9
-    assert np.abs(out[:, :4] - np.array(expected)).max() < 1e-9
-    # a master with a variable step: re-discretised for each step, one warning in all
-    runner = _estimator(fmu_dir)
-    steps = 0.01 * (1.0 + 0.5 * np.random.default_rng(5).random(len(data)))
+def _grid_reference(data, steps, Ts: float = 0.01) -> np.ndarray:
+    """OnlineEstimator on the Ts grid of the steps (time summed from 0): each step runs the samples it reaches
+    (blocks.stages.timing.grid_samples) on its row; the quaternion after each step."""
+    online, t, out = OnlineEstimator(gyro_offset=False), 0.0, []
     for row, h in zip(data, steps):
-        runner.step(row, h)
-    runner.close()
-    assert capsys.readouterr().out.count("differs from Ts") == 1
+        for _ in range(int(grid_samples(0.0, Ts, t, h))):
+            online.step(row[:3], row[3:], Ts)
+        t += h
+        out.append(online.quat)
+    return np.array(out)
+
+
+@pytest.mark.parametrize("path", ["AttitudeEstimator", "native/AttitudeEstimator"])
+def test_steps_of_other_sizes_run_on_the_ts_grid(fmu_dir, recording, capsys, path):
+    """Steps of 2·Ts run two samples of Ts on the step's inputs, and a master with a variable step (1 to 1.5 Ts)
+    one sample or none per step: the pythonfmu and the native FMU alike, as OnlineEstimator on that grid, with
+    nothing logged (the filter stays discretised for Ts)."""
+    gyr, acc = recording
+    data = np.hstack([gyr, acc])[:200]
+    for steps in (np.r_[np.full(100, 0.01), np.full(100, 0.02)],
+                  0.01 * (1.0 + 0.5 * np.random.default_rng(5).random(len(data)))):
+        runner = FmuRunner(fmu_dir / f"{path}.fmu", {"gyro_offset": "off"}, INPUTS, OUTPUTS, logging=True)
+        out = np.array([runner.step(row, h)[0] for row, h in zip(data, steps)])
+        runner.close()
+        assert np.abs(out[:, :4] - _grid_reference(data, steps)).max() < 1e-9
+    assert "differs from Ts" not in capsys.readouterr().out
 
 
 def test_a_step_size_with_rounding_noise_is_ts(fmu_dir, recording, capsys):

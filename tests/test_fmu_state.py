@@ -47,7 +47,6 @@ CONFIGS = {
 NAN, INF = math.nan, math.inf
 # (configuration, field, element, value): each a state with that one value out of its range
 FIELD_CASES = [
-    ("AttitudeEstimator", "noted_step", 0, 2),
     ("AttitudeEstimator", "discretised", 0, 2),
     ("AttitudeEstimator", "discretised", 0, 0),
     ("AttitudeEstimator", "pipeline.method.method", 0, 99),

@@ -237,24 +237,18 @@ def _logged_fmi2(fmu, parameters):
 
 
 @pytest.mark.parametrize("path", ["AttitudeEstimator", "native/AttitudeEstimator"])
-def test_a_step_other_than_ts_returns_fmi2_ok_and_is_noted_once(fmu_dir, path):
+def test_a_step_other_than_ts_returns_fmi2_ok_and_logs_nothing(fmu_dir, path):
     """A master that steps 0.01, 0.02, 0.005 and 0.013 s (the estimator's Ts 0.01 s): every doStep
-    returns fmi2OK (no warning a strict importer would take for a failure); one message, of
-    status fmi2OK, says the filter is re-discretised, at the first step of another size."""
+    returns fmi2OK (no warning a strict importer would take for a failure), each running the samples of
+    the Ts grid it reaches; no message but of status fmi2OK, none of the step size."""
     slave, vr, messages, unzipped = _logged_fmi2(fmu_dir / f"{path}.fmu", {"method": "tseng"})
     statuses, t = [], 0.0
-    for k, h in enumerate([TS, 2 * TS, TS / 2, 0.013, TS] * 4):
+    for h in [TS, 2 * TS, TS / 2, 0.013, TS] * 4:
         slave.setReal([vr[n] for n in INPUTS], [0.01, 0.0, -0.02, 0.1, 0.2, 9.8])
-        notes = len(messages)
         statuses.append(slave.fmi2DoStep(slave.component, t, h, 1))
-        if k == 1:
-            assert [m for m in messages[notes:] if "differs from Ts" in m[1]] == [
-                (0, "communication step 0.02 s differs from Ts = 0.01 s: filter re-discretised for it (and, "
-                    "without further notes, for every other step size)")]
         t += h
     assert statuses == [0] * len(statuses)
-    assert len([m for m in messages if "differs from Ts" in m[1]]) == 1
-    assert not [m for m in messages if m[0] != 0]
+    assert not [m for m in messages if "differs from Ts" in m[1] or m[0] != 0]
     slave.terminate()
     slave.freeInstance()
     shutil.rmtree(unzipped, ignore_errors=True)

@@ -26,6 +26,7 @@ from fmpy.validation import validate_fmu
 from attitude_fmu.blocks.methods.registry import METHODS
 from attitude_fmu.blocks.pipeline.causal import MAX_ACC_M_S2, MAX_GYR_RAD_S, valid_sample
 from attitude_fmu.blocks.pipeline.online import OnlineEstimator
+from attitude_fmu.blocks.stages.timing import grid_samples
 from attitude_fmu.systems.fmi.interface.variables import ENUMERATION, attitude_estimator
 from attitude_fmu.systems.fmi import native
 from attitude_fmu.systems.fmi.build import build_fmus
@@ -73,21 +74,24 @@ def stream(duration: float = 13.0, fast: float = 10.0, delay: int = 4):
 
 
 def reference(config: dict, rows, params=None):
-    """blocks.pipeline.online's step on the rows with the FMU's configuration: the outputs
-    (held where a sample is not taken), valid, and the status the FMU returns (1: a warning for
-    an input not taken that is invalid; a step size other than TS is re-discretised, with
-    fmi2OK)."""
+    """blocks.pipeline.online's step on the rows (t, h, inputs) with the FMU's configuration, on the TS
+    grid: each row runs the samples of TS its step reaches (blocks.stages.timing.grid_samples; a step of
+    2·TS two, on the same inputs). The outputs (held where a sample is not taken), valid, and the status
+    the FMU returns (1: a warning for an input not taken that is invalid)."""
     est = OnlineEstimator(config["method"], params, heading=config["heading"] == "mag",
                           gyro_offset=config["gyro_offset"] == "on", latency=config["latency"],
                           gyr_samples=config["gyr_samples"], acc_samples=config["acc_samples"])
     out, valid, status = np.empty((len(rows), len(OUTPUTS))), np.empty(len(rows), bool), np.zeros(len(rows))
-    last = START
-    for k, (_, h, *u) in enumerate(rows):
-        valid[k] = est.step(u[0:3], u[3:6], h, u[6:9])
-        if valid[k]:
-            last = np.r_[est.quat, est.up, est.euler, est.offset, est.mag_offset, est.mag_delay]
-        elif not valid_sample(u[0:3], u[3:6]):
-            status[k] = 1
+    last, taken = START, False
+    for k, (t, h, *u) in enumerate(rows):
+        status[k] = 0
+        for _ in range(int(grid_samples(0.0, TS, t, h))):
+            taken = est.step(u[0:3], u[3:6], TS, u[6:9])
+            if taken:
+                last = np.r_[est.quat, est.up, est.euler, est.offset, est.mag_offset, est.mag_delay]
+            elif not valid_sample(u[0:3], u[3:6]):
+                status[k] = 1
+        valid[k] = taken
         out[k] = last
     return out, valid, status
 

@@ -13,6 +13,7 @@ import zipfile
 from pathlib import Path
 
 import pytest
+from fmpy import read_model_description
 
 from attitude_fmu.systems.fmi.verify import write_verify_ssp
 from attitude_fmu.systems.recordings import output
@@ -203,6 +204,8 @@ def test_the_python_backend_writes_any_output_name(tmp_path):
         names = zf.namelist()
     assert "modelDescription.xml" in names and any(n.startswith("binaries/") and "/plant." in n for n in names)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["other_name.fmu"]
+    # it steps at dt only (PythonSystem refuses another step), and says so
+    assert read_model_description(str(path)).coSimulation.canHandleVariableCommunicationStepSize is False
 
 
 def test_copy_file_keeps_the_sources_permissions(tmp_path):

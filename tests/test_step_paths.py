@@ -1,9 +1,10 @@
 """One test body over every way a step of the estimator is reached, each held to the golden
 outputs (tests/golden.py), as VQF's test_implementation_comparison.py runs one body over its
-implementations: the online estimator (OnlineEstimator), the native FMU stepped by fmpy (its
-own C configuration, design and discretisation, with the sample time changed midway), the
-pythonfmu FMU, and, where the stream's sample time is constant, the batch path (estimate) and
-the python-control block (estimator_system under control.input_output_response)."""
+implementations: the online estimator (OnlineEstimator, through the streams' changes of sample time),
+and, where the stream's sample time is constant (up to its first change), the native FMU stepped by
+fmpy (its own C configuration, design and discretisation), the pythonfmu FMU (both run on the grid
+of their fixed Ts: tests/test_sample_grid.py), the batch path (estimate) and the python-control
+block (estimator_system under control.input_output_response)."""
 import copy
 import math
 import pickle
@@ -101,13 +102,13 @@ METHOD_CASES = {f"method {n} {' '.join(f'{k}={v}' for k, v in g.items())}": (n, 
 def test_every_path_to_a_methods_step_gives_its_frozen_outputs(fmus, case, path):
     """Each method alone (no gyro offset, no heading) over golden.hard_motion: fast tumbling,
     upside down, linear accelerations, no accelerometer for three samples, the sample time
-    changed twice (the batch path and the block, whose sample time is fixed: up to the first
-    change)."""
+    changed twice (the paths whose sample time is fixed, the FMUs, the batch path and the block: up
+    to the first change)."""
     name, given = METHOD_CASES[case]
     Ts, gyr, acc = golden.hard_motion()
     mag = np.full_like(gyr, np.nan)
     config = dict(method=name, params=given, gyro_offset=False)
-    if path in ("estimate", "estimator_system"):
+    if path != "online":
         assert np.all(Ts[:CONSTANT_TS] == Ts[0]) and Ts[CONSTANT_TS] != Ts[0]
         Ts, gyr, acc = Ts[:CONSTANT_TS], gyr[:CONSTANT_TS], acc[:CONSTANT_TS]
     if path == "online":
@@ -142,7 +143,7 @@ def test_every_path_to_the_online_pipeline_gives_its_frozen_outputs(fmus, case, 
     if path == "online":
         out, taken = _online(config, gyr, acc, mag, Ts)
     else:
-        out, taken = fmus[path].run(_fmu_start(config, Ts[0]), gyr, acc, mag, Ts)
+        out, taken = fmus[path].run(_fmu_start(config, Ts[0]), *_constant_ts(gyr, acc, mag, Ts))
     assert not taken[:3].any() and taken[3:600].all() and not taken[600:605].any()
     _assert_frozen(out, taken, FROZEN[case], f"{case} by {path}")
 
@@ -150,7 +151,7 @@ def test_every_path_to_the_online_pipeline_gives_its_frozen_outputs(fmus, case, 
 @pytest.mark.parametrize("case", PYTHONFMU_CASES)
 def test_the_pythonfmu_estimator_gives_the_frozen_online_outputs(fmus, case):
     gyr, acc, mag, Ts = golden.human_stream()
-    out, taken = fmus["pythonfmu"].run(_fmu_start(ONLINE_CASES[case], Ts[0]), gyr, acc, mag, Ts)
+    out, taken = fmus["pythonfmu"].run(_fmu_start(ONLINE_CASES[case], Ts[0]), *_constant_ts(gyr, acc, mag, Ts))
     _assert_frozen(out, taken, FROZEN[case], f"{case} by the pythonfmu FMU")
 
 
@@ -180,6 +181,14 @@ def test_a_copy_of_the_online_estimator_continues_as_the_original_and_a_reset_st
     est.reset()
     assert not est.ready
     _assert_frozen(*_online_continued(est, gyr, acc, mag, Ts), FROZEN[case], f"{case} after a reset")
+
+
+def _constant_ts(*columns):
+    """The rows of columns (their last the sample times) up to the first change of sample time: an FMU's Ts is
+    fixed at initialisation, and a step of another size runs on its grid, not at its own size."""
+    Ts = columns[-1]
+    n = int(np.argmax(Ts != Ts[0])) or len(Ts)
+    return [c[:n] for c in columns]
 
 
 def _online_continued(est, gyr, acc, mag, Ts):

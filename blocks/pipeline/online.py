@@ -8,7 +8,6 @@ import numpy as np
 
 from attitude_fmu import _core
 from attitude_fmu.blocks.pipeline.causal import configure
-from attitude_fmu.blocks.stages.timing import same_step  # noqa: F401 (the FMU's check of its step size)
 
 NO_FIELD = (0.0, 0.0, 0.0)  # a magnetometer input with no sample (NaN works too)
 

@@ -35,6 +35,10 @@ from attitude_fmu.blocks.tuning import STANDARD_GRAVITY
 # keeps time in integer nanoseconds, or sums steps in floating point, hands over Ts with rounding
 # noise), and same_step(Ts, reference), whether Ts is reference up to it
 STEP_TOLERANCE, same_step = _core.STEP_TOLERANCE, _core.same_step
+# an FMU with a sample time runs, in a communication step, grid_samples(start, Ts, t, h) samples: the
+# instants start + k·Ts its step reaches, up to GRID_TOLERANCE samples (a master that sums its steps falls
+# short by picoseconds), GRID_MAX_SAMPLES at most
+GRID_TOLERANCE, GRID_MAX_SAMPLES, grid_samples = _core.GRID_TOLERANCE, _core.GRID_MAX_SAMPLES, _core.grid_samples
 MAX_LATENCY_S = _core.MAX_LATENCY_S  # s: the gyro's last rate is no guide to the orientation further ahead
 GYR_SAMPLES, ACC_SAMPLES = _core.GYR_SAMPLES, _core.ACC_SAMPLES  # the sample conventions (above), the usual first
 

@@ -93,7 +93,7 @@ struct Fmi2Instance {
     fmi2Real time;            /* FMI 3.0's independent variable `time` (s): the start time, then the end of
                                  each step taken; held in FMU states */
     fmi2Real start_time;      /* the experiment's start time (s; fmi2SetupExperiment, fmi3EnterInitializationMode):
-                                 where a sample time's grid begins (fmi2_samples); not held in FMU states */
+                                 where a sample time's grid begins (timing.h: grid_samples); not held in FMU states */
     void **states;            /* the FMU states this instance made and has not freed (fmi2/fmu_state.h) */
     size_t n_states, states_capacity;
 };
@@ -106,15 +106,6 @@ void fmi2_log(Fmi2Instance *instance, fmi2Status status, const char *format, ...
     __attribute__((format(printf, 3, 4)))
 #endif
     ;
-
-/* The instants of a sample time Ts (s) that a communication step from t over h (s) reaches: the count of
- * start_time + k*Ts, k >= 1, in (t, t + h], each instant taken as reached when the step ends within
- * FMI2_GRID_TOLERANCE samples short of it (a master that sums its steps ends 60 s of 0.01 s at
- * 59.99999999999663) and as passed when t is within that after it. A model with a sample time runs that
- * many samples in the step, its inputs held: none holds its state and outputs, several run in turn.
- * Ts finite and positive, t and t + h finite; a count beyond 2^53 is returned as such. */
-#define FMI2_GRID_TOLERANCE 1e-6
-double fmi2_samples(const Fmi2Instance *instance, double Ts, double t, double h);
 
 /* The item name of the value of the Enumeration held at integers[index], or NULL with an error logged
  * if the value is none of its items' (sets are checked: a restored FMU state is not) or no Enumeration

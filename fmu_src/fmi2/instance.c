@@ -127,12 +127,6 @@ void fmi2_instance_reset(Fmi2Instance *instance) {
     instance->start_time = 0.0;
 }
 
-double fmi2_samples(const Fmi2Instance *instance, double Ts, double t, double h) {
-    double before = floor((t - instance->start_time) / Ts + FMI2_GRID_TOLERANCE);
-    double after = floor((t + h - instance->start_time) / Ts + FMI2_GRID_TOLERANCE);
-    return after > before ? after - before : 0.0;
-}
-
 size_t fmi2_data_size(void) {
     size_t offsets[5];
     return layout(offsets);

@@ -1,6 +1,9 @@
 /* AttitudeEstimator.c: the model of the native AttitudeEstimator.fmu: its variables
  * (AttitudeEstimator_variables.h, generated from systems/fmi/interface/variables.py) onto the C core's online
- * estimator (core/pipeline/online.h).
+ * estimator (core/pipeline/online.h), on the grid of its sample time Ts from the start time
+ * (stages/timing.h: grid_samples): a communication step runs the samples it reaches with its inputs
+ * held, one that reaches none (half a sample; a master's final shortfall of picoseconds) holds the
+ * estimate, several run in turn.
  * fmu_src/AttitudeEstimator.py is the pythonfmu model of the same variables (the same checks,
  * messages and statuses). */
 #include <math.h>
@@ -12,11 +15,9 @@
 #include "stages/timing.h"
 
 #define MESSAGE_SIZE 1024
-#define LONG_STEP_S 1.0 /* steps longer than this keep the state to fall back on whatever their length */
 
 typedef struct {
     AfOnline estimator;
-    int noted_step; /* a step size other than Ts was logged (once: a master with variable steps would log each) */
 } Model;
 
 static const Fmi2Variable *variable_named(const char *name) {
@@ -63,7 +64,6 @@ static fmi2Status initialise(Fmi2Instance *instance) {
         fmi2_log(instance, fmi2Error, "invalid parameter: %s", message);
         return fmi2Error;
     }
-    model->noted_step = 0;
     return fmi2OK;
 }
 
@@ -83,47 +83,27 @@ static int outputs_finite(const AfOnline *est) {
 
 static int validate(const void *state, const void *configured, char *message, size_t size) {
     const Model *model = state;
-    if (model->noted_step != 0 && model->noted_step != 1)
-        return refuse(message, size, "the flag 'noted_step' is %d, not 0 or 1", model->noted_step);
     return af_online_validate(&model->estimator, &((const Model *)configured)->estimator, message, size);
 }
 
-static fmi2Status step(Fmi2Instance *instance, fmi2Real t, fmi2Real h) {
-    Model *model = instance->state;
+/* one sample of Ts (s) at t (s) on the inputs as they are: fmi2OK with the outputs, fmi2Warning with the
+ * estimate held where the inputs are not a sample to take, fmi2Error where the arithmetic fails */
+static fmi2Status sample(Fmi2Instance *instance, Model *model, double t) {
     AfOnline *est = &model->estimator;
     fmi2Real *r = instance->reals;
-    fmi2Status status = fmi2OK;
     char message[MESSAGE_SIZE], a[FLOAT_REPR_SIZE], b[FLOAT_REPR_SIZE];
-    if (!isfinite(t + h)) {
-        fmi2_log(instance, fmi2Error, "a step of %s s to %s s overflows the estimator's arithmetic; the estimate held",
-                 float_repr(h, a), float_repr(t + h, b));
-        return fmi2Error;
-    }
-    /* What a step the arithmetic cannot take leaves: kept where the step is new to the filter (it is
-     * re-discretised for it) or longer than LONG_STEP_S; a step of the length the filter was discretised
-     * for, on inputs in every IMU's range, keeps its outputs finite, and is not slowed by the copy. */
-    Model before;
-    const int keep = !(est->discretised && same_step(h, est->step.Ts)) || h > LONG_STEP_S;
-    if (keep) before = *model;
-    if (!model->noted_step && !same_step(h, r[REAL_Ts])) {
-        model->noted_step = 1;
-        fmi2_log(instance, fmi2OK, "communication step %g s differs from Ts = %g s: filter re-discretised for it "
-                 "(and, without further notes, for every other step size)", h, r[REAL_Ts]);
-    }
     /* each vector's components are consecutive in the table: x, y, z (w, x, y, z) */
     const double gyr[3] = {r[REAL_gyr_x], r[REAL_gyr_y], r[REAL_gyr_z]};
     const double acc[3] = {r[REAL_acc_x], r[REAL_acc_y], r[REAL_acc_z]};
     const double mag[3] = {r[REAL_mag_x], r[REAL_mag_y], r[REAL_mag_z]};
-    int taken = af_online_step(est, gyr, acc, mag, h, message, sizeof message);
+    int taken = af_online_step(est, gyr, acc, mag, est->step.Ts, message, sizeof message);
     if (taken < 0) {
-        if (keep) *model = before;
         fmi2_log(instance, fmi2Error, "%s", message);
         return fmi2Error;
     }
     if (taken == 1 && !outputs_finite(est)) {
-        if (keep) *model = before;
-        fmi2_log(instance, fmi2Error, "a step of %s s to %s s overflows the estimator's arithmetic; the estimate held",
-                 float_repr(h, a), float_repr(t + h, b));
+        fmi2_log(instance, fmi2Error, "a step of %s s to %s s overflows the estimator's arithmetic; the estimate "
+                 "held", float_repr(est->step.Ts, a), float_repr(t + est->step.Ts, b));
         return fmi2Error;
     }
     instance->booleans[BOOLEAN_valid] = taken == 1;
@@ -134,12 +114,56 @@ static fmi2Status step(Fmi2Instance *instance, fmi2Real t, fmi2Real h) {
         put(&r[REAL_gyr_offset_x], est->offset, 3);
         put(&r[REAL_mag_offset_x], est->mag_offset, 3);
         r[REAL_mag_delay_used] = est->mag_delay;
-    } else if (!valid_sample(gyr, acc)) {
-        int finite = 1;
-        for (int i = 0; i < 3; i++) finite = finite && isfinite(gyr[i]) && isfinite(acc[i]);
-        fmi2_log(instance, fmi2Warning, "t=%g: %s; estimate held", t,
-                 finite ? "input beyond every IMU's range" : "non-finite input");
-        status = fmi2Warning;
+        return fmi2OK;
+    }
+    if (valid_sample(gyr, acc)) return fmi2OK;
+    int finite = 1;
+    for (int i = 0; i < 3; i++) finite = finite && isfinite(gyr[i]) && isfinite(acc[i]);
+    fmi2_log(instance, fmi2Warning, "t=%g: %s; estimate held", t,
+             finite ? "input beyond every IMU's range" : "non-finite input");
+    return fmi2Warning;
+}
+
+/* n samples of Ts from first (s) in turn, the inputs held: the worst status, at fmi2Error the first that failed */
+static fmi2Status samples(Fmi2Instance *instance, Model *model, double first, double n) {
+    const double Ts = model->estimator.step.Ts;
+    fmi2Status status = fmi2OK;
+    for (double k = 0.0; k < n; k++) {
+        fmi2Status taken = sample(instance, model, first + k * Ts);
+        if (taken == fmi2Error) return fmi2Error;
+        if (taken > status) status = taken;
+    }
+    return status;
+}
+
+static fmi2Status step(Fmi2Instance *instance, fmi2Real t, fmi2Real h) {
+    Model *model = instance->state;
+    const double Ts = model->estimator.step.Ts;
+    char a[FLOAT_REPR_SIZE], b[FLOAT_REPR_SIZE];
+    if (!isfinite(t + h)) {
+        fmi2_log(instance, fmi2Error, "a step of %s s to %s s overflows the estimator's arithmetic; the estimate held",
+                 float_repr(h, a), float_repr(t + h, b));
+        return fmi2Error;
+    }
+    const double n = grid_samples(instance->start_time, Ts, t, h);
+    if (n > GRID_MAX_SAMPLES) {
+        fmi2_log(instance, fmi2Error, "a step of %s s reaches %.0f samples of Ts = %s s; one step runs %.0f at most: "
+                 "the estimate held", float_repr(h, a), n, float_repr(Ts, b), GRID_MAX_SAMPLES);
+        return fmi2Error;
+    }
+    const double first = instance->start_time + floor((t - instance->start_time) / Ts + GRID_TOLERANCE) * Ts;
+    if (n <= 1.0) return n == 1.0 ? samples(instance, model, first, 1.0) : fmi2OK;
+    /* a sample of Ts on inputs in every IMU's range keeps the outputs finite; a run of several falls back on
+     * the state before it where one fails, a single one needs no copy (and is not slowed by it) */
+    const Model before = *model;
+    fmi2Real reals[N_REALS];
+    memcpy(reals, instance->reals, sizeof reals);
+    const fmi2Boolean valid = instance->booleans[BOOLEAN_valid];
+    fmi2Status status = samples(instance, model, first, n);
+    if (status == fmi2Error) {
+        *model = before;
+        memcpy(instance->reals, reals, sizeof reals);
+        instance->booleans[BOOLEAN_valid] = valid;
     }
     return status;
 }

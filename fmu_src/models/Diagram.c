@@ -3,7 +3,7 @@
  * (diagram/diagram.h), each block stepped by its kind's C step (diagram/kinds.h). After the step that
  * ends at t[k+1] the outputs are the diagram's at sample k, as control.input_output_response gives
  * them, the inputs of sample k held over the step. A discrete diagram (DIAGRAM_DT > 0) runs on the grid of
- * its sample time from the start time (fmi2_samples): a step runs the samples it reaches, its inputs held,
+ * its sample time from the start time (timing.h: grid_samples): a step runs the samples it reaches, its inputs held,
  * none (a master's shortfall of picoseconds, half a sample) holding state and outputs, several in turn; a
  * continuous one (LTI blocks only) takes any step, its blocks held over it by zero-order hold. */
 #include <math.h>
@@ -17,7 +17,6 @@
 
 #define MESSAGE_SIZE 1024
 #define AT_LEAST_1(n) ((n) > 0 ? (n) : 1) /* C99 has no empty arrays */
-#define MAX_SAMPLES 1048576.0 /* samples one step may run (a bound on the work of one call) */
 #define HOLD_WORK ZERO_ORDER_HOLD_WORK(DIAGRAM_LTI_SIZE, 0) /* any LTI block's hold: n + m <= DIAGRAM_LTI_SIZE */
 
 #if DIAGRAM_LTI_SIZE > DIAGRAM_LTI_MAX
@@ -377,11 +376,11 @@ static fmi2Status step(Fmi2Instance *instance, fmi2Real t, fmi2Real h)
     fmi2Real *r = instance->reals;
     char a[FLOAT_REPR_SIZE], b2[FLOAT_REPR_SIZE];
     if (DIAGRAM_DT == 0.0) return hold(instance, model, h) ? fmi2Error : sample(instance, model, t, h);
-    const double n = fmi2_samples(instance, DIAGRAM_DT, t, h);
-    if (n > MAX_SAMPLES) {
+    const double n = grid_samples(instance->start_time, DIAGRAM_DT, t, h);
+    if (n > GRID_MAX_SAMPLES) {
         fmi2_log(instance, fmi2Error, "a step of %s s from t=%g reaches %.0f samples of the diagram's sample time %s s; "
                  "one step runs %.0f at most: its state and outputs held", float_repr(h, a), t, n,
-                 float_repr(DIAGRAM_DT, b2), MAX_SAMPLES);
+                 float_repr(DIAGRAM_DT, b2), GRID_MAX_SAMPLES);
         return fmi2Error;
     }
     double x[AT_LEAST_1(DIAGRAM_N_STATES)], y[AT_LEAST_1(DIAGRAM_N_OUTPUTS)] = {0.0}; /* what a refused sample
@@ -389,7 +388,7 @@ static fmi2Status step(Fmi2Instance *instance, fmi2Real t, fmi2Real h)
     memcpy(x, model->x, sizeof x);
     for (size_t i = 0; i < n_outputs; i++) y[i] = r[DIAGRAM_OUTPUT0 + i];
     const double first = instance->start_time + (floor((t - instance->start_time) / DIAGRAM_DT +
-                                                       FMI2_GRID_TOLERANCE)) * DIAGRAM_DT; /* the sample before */
+                                                       GRID_TOLERANCE)) * DIAGRAM_DT; /* the sample before */
     for (double k = 0.0; k < n; k++)
         if (sample(instance, model, first + k * DIAGRAM_DT, DIAGRAM_DT) != fmi2OK) {
             memcpy(model->x, x, sizeof x);

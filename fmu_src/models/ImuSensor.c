@@ -3,7 +3,7 @@
  * delay line (delay_line.h) and noise streams (noise.h): step k draws sample k of the
  * streams SENSOR and MAGNETOMETER of `seed`, as ImuModel.apply and apply_mag draw them.
  * With a latency the first step's size is the sensor's sample time, and later steps run on its grid
- * from the start time (fmi2_samples): the samples a step reaches, its inputs held; none (a master's
+ * from the start time (timing.h: grid_samples): the samples a step reaches, its inputs held; none (a master's
  * shortfall of picoseconds, half a sample) holds the outputs; several run in turn. Without one, each
  * step is a sample of its own length.
  * The pythonfmu ImuSensor (fmu_src/ImuSensor.py) runs the same C core with the same checks,
@@ -16,10 +16,10 @@
 #include "messages.h"
 #include "delay_line.h"
 #include "noise.h"
+#include "stages/timing.h"
 #include "sensor.h"
 
 #define MESSAGE_SIZE 512
-#define MAX_SAMPLES 1048576.0 /* samples one step may run (a bound on the work of one call) */
 
 typedef struct {
     ImuParams params;
@@ -108,11 +108,11 @@ static fmi2Status step(Fmi2Instance *instance, fmi2Real t, fmi2Real h) {
         sample(instance, model, h);
         return fmi2OK;
     }
-    const double n = fmi2_samples(instance, model->step_size, t, h);
-    if (n > MAX_SAMPLES) {
+    const double n = grid_samples(instance->start_time, model->step_size, t, h);
+    if (n > GRID_MAX_SAMPLES) {
         fmi2_log(instance, fmi2Error, "a step of %s s reaches %.0f samples of the sensor's sample time %s s (its "
                  "first step's); one step runs %.0f at most", float_repr(h, a), n, float_repr(model->step_size, b),
-                 MAX_SAMPLES);
+                 GRID_MAX_SAMPLES);
         return fmi2Error;
     }
     for (double k = 0.0; k < n; k++) sample(instance, model, model->step_size);

@@ -217,7 +217,6 @@ typedef struct {
 
 static const Field FIELDS[] = {
 #if defined(AF_MODEL_AttitudeEstimator)
-    FIELD("noted_step", noted_step, F_INT),
     FIELD("discretised", estimator.discretised, F_INT),
     FIELD("pipeline.method.method", estimator.pipeline.method.method, F_INT),
     FIELD("pipeline.method.kernel", estimator.pipeline.method.kernel, F_INT),

@@ -224,6 +224,8 @@ void bind_stages(nb::module_ &m)
 
     // ---- sample timing and latency
     m.attr("STEP_TOLERANCE") = STEP_TOLERANCE;
+    m.attr("GRID_TOLERANCE") = GRID_TOLERANCE;
+    m.attr("GRID_MAX_SAMPLES") = GRID_MAX_SAMPLES;
     m.attr("MAX_LATENCY_S") = MAX_LATENCY_S;
     m.def("check_latency", [](double latency) {
         char message[MESSAGE_SIZE];
@@ -250,6 +252,9 @@ void bind_stages(nb::module_ &m)
     m.def("same_step", [](double Ts, double reference) { return same_step(Ts, reference) != 0; },
           nb::arg("Ts"), nb::arg("reference"),
           "Whether the sample time Ts (s) is reference (s) up to STEP_TOLERANCE.");
+    m.def("grid_samples", &grid_samples, nb::arg("start"), nb::arg("Ts"), nb::arg("t"), nb::arg("h"),
+          "The instants start + k*Ts (s, k >= 1) that a communication step from t over h (s) reaches, up to "
+          "GRID_TOLERANCE samples: the samples an FMU with the sample time Ts runs in it, its inputs held.");
     m.def("carry_forward_rows", [](Rows4 quat, Rows3 gravity, const Rows3 &gyr, double latency) {
         size_t n = quat.shape(0);
         check_rows(gravity.shape(0), n, "gravity");

@@ -30,6 +30,12 @@ int same_step(double Ts, double reference)
     return fabs(Ts - reference) <= STEP_TOLERANCE * reference;
 }
 
+double grid_samples(double start, double Ts, double t, double h)
+{
+    double before = floor((t - start) / Ts + GRID_TOLERANCE), after = floor((t + h - start) / Ts + GRID_TOLERANCE);
+    return after > before ? after - before : 0.0;
+}
+
 Vec3 interval_mean(Vec3 before, Vec3 now)
 {
     return (Vec3){0.5 * (before.x + now.x), 0.5 * (before.y + now.y), 0.5 * (before.z + now.z)};

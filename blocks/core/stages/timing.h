@@ -22,6 +22,16 @@ int check_samples(const char *gyr_samples, const char *acc_samples, char *messag
 /* Whether the sample time Ts (s) is reference (s) up to STEP_TOLERANCE. */
 int same_step(double Ts, double reference);
 
+/* a sample grid's instant this many samples past a step's end counts as reached (a master that sums its
+ * steps ends 60 s of 0.01 s at 59.99999999999663), this many past its start as passed */
+#define GRID_TOLERANCE 1e-6
+#define GRID_MAX_SAMPLES 1048576.0 /* samples one communication step may run: a bound on one call's work */
+
+/* The instants start + k*Ts (s, k >= 1) of a sample grid that a communication step from t over h (s)
+ * reaches, up to GRID_TOLERANCE: how many samples an FMU with the sample time Ts runs in the step, its
+ * inputs held (none: its state and outputs held). Ts finite and positive; t and t + h finite. */
+double grid_samples(double start, double Ts, double t, double h);
+
 /* The mean rate over the sample time between two point samples of it (rad/s): the trapezoid. */
 Vec3 interval_mean(Vec3 before, Vec3 now);
 

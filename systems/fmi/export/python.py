@@ -42,6 +42,7 @@ def write_python(path: Path, name: str, system, x0, step, fmi_version: str) -> P
         (Path(tmp) / SYSTEM_FILE).write_bytes(cloudpickle.dumps((system, x0, float(dt))))
         built = FmuBuilder.build_FMU(script, dest=Path(tmp) / "out", project_files=[Path(tmp) / SYSTEM_FILE],
                                      needsExecutionTool="false", canGetAndSetFMUstate="true",
-                                     canSerializeFMUstate="true")
+                                     canSerializeFMUstate="true",
+                                     canHandleVariableCommunicationStepSize="false")  # dt only: PythonSystem
         guarded(Path(built), guard_binary())
         return copy_file(built, path)

@@ -232,7 +232,8 @@ def attitude_estimator() -> tuple[Variable, ...]:
              "against disturbances) or gyro")
     t.choice("gyro_offset", ("on", "off"), "on", "on (default, as attitude estimate): estimate and remove the gyro "
              "offset (at rest and while moving); off: for a gyro without offset")
-    t.real("Ts", 0.01, "s", "sample time the estimator expects (other step sizes are re-discretised)", PAR)
+    t.real("Ts", 0.01, "s", "sample time of the estimator: a communication step runs the samples of its grid "
+           "(start time + k·Ts) it reaches, its inputs held", PAR)
     t.choice("gyr_samples", GYR_SAMPLES, "mean", "mean: gyr is the mean rate over the step (the FMI convention of "
              "MotionProfile and ImuSensor); point: the rate at the step's end (most models' outputs), "
              "averaged with the last one")
