@@ -40,10 +40,6 @@ class AttitudeEstimator(ProjectSlave):
         super().__init__(**kwargs)
         self.register_table(attitude_estimator())
         self.estimator = None
-        self.start_time = 0.0  # where the sample grid begins (fmi2SetupExperiment)
-
-    def setup_experiment(self, start_time, stop_time=None, tolerance=None):
-        self.start_time = float(start_time)
 
     def initialise(self):
         if not (math.isfinite(self.Ts) and self.Ts > 0):

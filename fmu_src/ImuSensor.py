@@ -5,7 +5,10 @@ SENSOR for the gyro and accelerometer, MAGNETOMETER for the magnetometer), sampl
 the run as sample k of the batch path, so a run equals ImuModel.apply and
 ImuModel.apply_mag on the same samples. With a
 `latency`, the measured signals are those of the motion that long ago (ImuModel's delay
-line; before the first step, the motion of the first step), which needs a fixed step.
+line; before the first step, the motion of the first step), and the first step's size is the
+sensor's sample time: later steps run on its grid from the start time
+(blocks.stages.timing.grid_samples), the samples a step reaches with its inputs held, none
+holding the outputs.
 """
 from __future__ import annotations
 
@@ -13,7 +16,7 @@ import math
 
 import numpy as np
 
-from attitude_fmu.blocks.stages.timing import same_step
+from attitude_fmu.blocks.stages.timing import GRID_MAX_SAMPLES, grid_samples
 from attitude_fmu.fmu_src.fmu_support import ProjectSlave
 from attitude_fmu.systems.fmi.interface.simulation_variables import imu_sensor
 from attitude_fmu.systems.simulation.noise import MAGNETOMETER, SENSOR, NoiseStream
@@ -52,19 +55,29 @@ class ImuSensor(ProjectSlave):
             return self.refuse_step()
         if not (math.isfinite(step_size) and step_size > 0):
             return self.fail(f"step size must be positive, got {step_size!r}")
+        if not self.model.latency:
+            return self._sample(step_size)
+        if self.delay is None:  # the first step: the sample time, the delay line filled with the inputs
+            signals = np.array([self.omega_x, self.omega_y, self.omega_z, self.f_x, self.f_y, self.f_z])
+            try:
+                self.delay, self.step_size = self.model.delay_state(1.0 / step_size, signals), step_size
+            except ValueError as exc:  # a latency longer than the delay line holds
+                return self.fail(str(exc))
+            return self._sample(step_size)
+        n = grid_samples(self.start_time, self.step_size, current_time, step_size)
+        if n > GRID_MAX_SAMPLES:
+            return self.fail(f"a step of {step_size!r} s reaches {n:.0f} samples of the sensor's sample time "
+                             f"{self.step_size!r} s (its first step's); one step runs {GRID_MAX_SAMPLES:.0f} at most")
+        return all(self._sample(self.step_size) for _ in range(int(n)))
+
+    def _sample(self, h: float) -> bool:
+        """One sample of h (s) of the inputs as they are: the outputs, the delay line stepped (a latency)."""
         signals = np.array([self.omega_x, self.omega_y, self.omega_z, self.f_x, self.f_y, self.f_z])
         if self.model.latency:
-            if self.delay is None:
-                try:
-                    self.delay, self.step_size = self.model.delay_state(1.0 / step_size, signals), step_size
-                except ValueError as exc:  # a latency longer than the delay line holds
-                    return self.fail(str(exc))
-            elif not same_step(step_size, self.step_size):
-                return self.fail(f"latency needs a fixed step: got {step_size!r} s after {self.step_size!r} s")
             self.delay, signals = self.model.delay_step(self.delay, signals, 1.0 / self.step_size)
-        gyr, acc = self.model.measure(signals[0:3], signals[3:6], self.rng.next(), 1.0 / step_size)
+        gyr, acc = self.model.measure(signals[0:3], signals[3:6], self.rng.next(), 1.0 / h)
         self.gyr_x, self.gyr_y, self.gyr_z = (float(v) for v in gyr)
         self.acc_x, self.acc_y, self.acc_z = (float(v) for v in acc)
-        mag = self.model.measure_mag((self.m_x, self.m_y, self.m_z), self.mag_rng.next(), 1.0 / step_size)
+        mag = self.model.measure_mag((self.m_x, self.m_y, self.m_z), self.mag_rng.next(), 1.0 / h)
         self.mag_x, self.mag_y, self.mag_z = (float(v) for v in mag)
         return True

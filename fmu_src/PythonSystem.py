@@ -4,7 +4,9 @@ initial state and sample time, stepped by python-control's own update and output
 
 Its inputs and outputs are Real variables named after the system's labels. After the doStep that
 ends at t[k+1], with the inputs of sample k held over it, the outputs are the system's outputs at
-sample k (control.input_output_response's); a step other than the system's dt is refused. The FMU
+sample k (control.input_output_response's). It runs on the grid of dt from the start time
+(blocks.stages.timing.grid_samples): a step runs the samples it reaches, its inputs held, and one that
+reaches none holds state and outputs. The FMU
 needs, where it runs, a Python with pythonfmu, numpy, control, cloudpickle and whatever the
 system's functions import (attitude_fmu for the project's blocks).
 """
@@ -18,6 +20,7 @@ import numpy as np
 from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Real
 from pythonfmu.enums import Fmi2Status
 
+from attitude_fmu.blocks.stages.timing import GRID_MAX_SAMPLES, GRID_TOLERANCE, grid_samples
 from attitude_fmu.systems.fmi.export.python import SYSTEM_FILE
 
 
@@ -32,6 +35,7 @@ class PythonSystem(Fmi2Slave):
         with open(Path(self.resources) / SYSTEM_FILE, "rb") as file:
             self.system, self.x0, self.dt = pickle.load(file)
         self.x = np.array(self.x0, dtype=float)
+        self.start_time = 0.0  # s: where the grid of dt begins
         self.u = np.zeros(self.system.ninputs)
         self.y = np.zeros(self.system.noutputs)
         for i, label in enumerate(self.system.input_labels):
@@ -42,17 +46,27 @@ class PythonSystem(Fmi2Slave):
             self.register_variable(Real(label, causality=Fmi2Causality.output, variability=Fmi2Variability.continuous,
                                         getter=lambda i=i: float(self.y[i])))
 
+    def setup_experiment(self, start_time, stop_time=None, tolerance=None):
+        self.start_time = float(start_time)
+
     def do_step(self, current_time, step_size):
-        if not math.isclose(step_size, self.dt, rel_tol=1e-9):
-            self.log(f"this system is discrete with sample time {self.dt!r} s; a step of {step_size!r} s is refused",
+        start, dt = self.start_time, self.dt
+        n = grid_samples(start, dt, current_time, step_size) if math.isfinite(current_time + step_size) else math.inf
+        if n > GRID_MAX_SAMPLES:
+            self.log(f"a step of {step_size!r} s from t={current_time!r} reaches {n:.0f} samples of the system's "
+                     f"sample time {dt!r} s; one step runs {GRID_MAX_SAMPLES:.0f} at most: step refused",
                      Fmi2Status.error)
             return False
-        y = np.asarray(self.system._out(current_time, self.x, self.u), dtype=float).reshape(-1)
-        x = np.asarray(self.system._rhs(current_time, self.x, self.u), dtype=float).reshape(-1)
-        if not (np.isfinite(y).all() and np.isfinite(x).all()):
-            self.log(f"t={current_time!r}: the system's outputs or next state are not finite; step refused",
-                     Fmi2Status.error)
-            return False
+        first = start + math.floor((current_time - start) / dt + GRID_TOLERANCE) * dt
+        x, y = self.x, self.y
+        for k in range(int(n)):
+            t = first + k * dt
+            y = np.asarray(self.system._out(t, x, self.u), dtype=float).reshape(-1)
+            x = np.asarray(self.system._rhs(t, x, self.u), dtype=float).reshape(-1)
+            if not (np.isfinite(y).all() and np.isfinite(x).all()):
+                self.log(f"t={t!r}: the system's outputs or next state are not finite; step refused",
+                         Fmi2Status.error)
+                return False
         self.y, self.x = y, x
         return True
 

@@ -46,6 +46,10 @@ class ProjectSlave(Fmi2Slave):
         super().__init__(**kwargs)
         self.table = Table()  # the variables registered, by value reference
         self.error = foreign_code(self.resources)
+        self.start_time = 0.0  # s: where a sample time's grid begins (blocks.stages.timing.grid_samples)
+
+    def setup_experiment(self, start_time, stop_time=None, tolerance=None):
+        self.start_time = float(start_time)
 
     def _get_fmu_state(self) -> dict:
         state = super()._get_fmu_state()

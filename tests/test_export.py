@@ -222,7 +222,8 @@ def test_refusals_name_the_blocks(tmp_path):
 def test_python_backend_exports_a_python_function_block(tmp_path):
     """A control.nlsys of Python functions through pythonfmu (with the project's guard): run by fmpy in a
     process of its own (pythonfmu's library may not be unloaded from a process that goes on), it equals
-    input_output_response."""
+    input_output_response; in steps of dt/2 (each input held over two) it runs on the grid of dt and gives
+    the same outputs after every second step."""
     dt = 0.1
     system = control.nlsys(lambda t, x, u, p: 0.5 * x + u[:1], lambda t, x, u, p: 2 * np.tanh(x[0] + u),
                            inputs=["a"], outputs=["b"], states=1, dt=dt, name="saturating")
@@ -236,13 +237,17 @@ def test_python_backend_exports_a_python_function_block(tmp_path):
               "from tests.test_export import fmu_outputs\n"
               "import control\n"
               "system = control.nlsys(None, lambda t, x, u, p: u, inputs=['a'], outputs=['b'], dt=0.1)\n"
-              "np.save('y.npy', fmu_outputs('saturating.fmu', np.load('u.npy'), 0.1, system))\n"
+              "h, repeat = float(sys.argv[2]), int(sys.argv[3])\n"
+              "u = np.repeat(np.load('u.npy'), repeat, axis=0)\n"
+              "np.save(f'y{repeat}.npy', fmu_outputs('saturating.fmu', u, h, system))\n"
               "sys.stdout.flush()\n"
               "os._exit(0)\n")
-    run = subprocess.run([sys.executable, "-c", script, str(Path(__file__).resolve().parent.parent)], cwd=tmp_path,
-                         capture_output=True, text=True)
-    assert run.returncode == 0, run.stderr[-3000:]
-    np.testing.assert_allclose(np.load(tmp_path / "y.npy"), reference(system, u, dt), rtol=0, atol=TOLERANCE)
+    for h, repeat in ((dt, 1), (dt / 2, 2)):
+        run = subprocess.run([sys.executable, "-c", script, str(Path(__file__).resolve().parent.parent), str(h),
+                              str(repeat)], cwd=tmp_path, capture_output=True, text=True)
+        assert run.returncode == 0, run.stderr[-3000:]
+    np.testing.assert_allclose(np.load(tmp_path / "y1.npy"), reference(system, u, dt), rtol=0, atol=TOLERANCE)
+    np.testing.assert_allclose(np.load(tmp_path / "y2.npy")[1::2], reference(system, u, dt), rtol=0, atol=TOLERANCE)
 
 
 def test_command_line_exports_a_file_the_test_writes(tmp_path):

@@ -483,17 +483,6 @@ def test_an_enumeration_value_out_of_its_items_range_ends_in_fmi2_error(fmu_dir,
     slave.freeInstance()
 
 
-def test_a_late_sensor_fmu_refuses_a_changed_step(fmu_dir, capsys):
-    """The delay line holds samples of one step size: another step ends in fmi2Error saying why."""
-    runner = FmuRunner(fmu_dir / "ImuSensor.fmu", {"latency": 0.015}, [f"f_{c}" for c in "xyz"], ["acc_z"])
-    assert runner.step([0.0, 0.0, 9.81], 0.01)[0][0] == 9.81
-    with pytest.raises(FMICallException) as info:
-        runner.step([0.0, 0.0, 9.81], 0.02)
-    assert info.value.status == 3
-    runner.close()
-    assert "latency needs a fixed step: got 0.02 s after 0.01 s" in capsys.readouterr().out
-
-
 def test_fmi_status_follows_the_log_and_reset_clears_an_error(fmu_dir, recording, capsys):
     """A step that logs a warning returns fmi2Warning; after an fmi2Error, fmi2Reset and valid
     parameters give a working instance again."""

@@ -103,28 +103,29 @@ def _shares_the_grid(path, parameters, inputs, first=None):
 
 
 SENSOR_INPUTS = {"omega_x": 0.3, "omega_y": -0.2, "omega_z": 0.1, "f_x": 0.5, "f_y": -0.4, "f_z": 9.8}
+SENSOR_PARAMETERS = {"latency": 0.013, "delta_n": 0.01, "acc_noise": 0.05, "mag_noise": 0.5}
 # a steady turn about the vertical in a field the estimator sees turn against the gyro: its heading works on
 ESTIMATOR_INPUTS = {"gyr_x": 0.02, "gyr_y": -0.01, "gyr_z": 0.05, "acc_x": 0.3, "acc_y": 0.2, "acc_z": 9.8,
                     "mag_x": 20.0, "mag_y": 5.0, "mag_z": -40.0}
-CASES = ["diagram 2.0", "diagram 3.0", "late-sensor native", "late-sensor native/fmi3", "estimator native",
-         "estimator native/fmi3", "estimator pythonfmu"]
+# (the python backend's FMU, whose pythonfmu library a process cannot load twice: tests/test_export.py)
+CASES = ["diagram 2.0", "diagram 3.0", "late-sensor native", "late-sensor native/fmi3",
+         "late-sensor pythonfmu", "estimator native", "estimator native/fmi3", "estimator pythonfmu"]
 
 
 @pytest.fixture(scope="module", params=CASES)
 def fmu(request, fmu_dir, tmp_path_factory):
     """(path, parameters, constant inputs, first step or None) of each FMU with a sample time: a discrete
-    diagram of two states exported natively (FMI 2.0, 3.0); the native ImuSensor with a latency and noise,
-    each sample drawing its own (its first step, TS, sets its sample time); the estimator with the
-    magnetometer's heading (native FMI 2.0 and 3.0, pythonfmu)."""
+    diagram of two states exported natively (FMI 2.0 and 3.0); the ImuSensor with a latency
+    and noise, each sample drawing its own (its first step, TS, sets its sample time; native FMI 2.0 and 3.0,
+    pythonfmu); the estimator with the magnetometer's heading (native FMI 2.0 and 3.0, pythonfmu)."""
     kind, where = request.param.split()
+    folder = fmu_dir if where == "pythonfmu" else fmu_dir / where
     if kind == "diagram":
         system = control.ss([[0.9, 0.1], [0.0, 0.8]], [[1.0], [0.5]], [[1.0, -1.0]], [[0.2]], TS, name="plant")
         path = tmp_path_factory.mktemp("grid") / "plant.fmu"
         return export_fmu(system, path, fmi_version=where, cmake_options=BUILD), {}, {"u[0]": 1.0}, None
     if kind == "late-sensor":
-        return (fmu_dir / where / "ImuSensor.fmu", {"latency": 0.013, "delta_n": 0.01, "acc_noise": 0.05,
-                                                    "mag_noise": 0.5}, SENSOR_INPUTS, TS)
-    folder = fmu_dir if where == "pythonfmu" else fmu_dir / where
+        return folder / "ImuSensor.fmu", SENSOR_PARAMETERS, SENSOR_INPUTS, TS
     return folder / "AttitudeEstimator.fmu", {}, ESTIMATOR_INPUTS, None
 
 
@@ -139,3 +140,19 @@ def test_the_shortfall_step_returns_ok_and_holds_the_outputs(fmu):
 def test_steps_of_half_and_three_samples_run_the_samples_they_reach(fmu):
     path, parameters, inputs, first = fmu
     _shares_the_grid(path, parameters, inputs, first)
+
+
+def test_the_pythonfmu_late_sensor_equals_the_native_one_on_mixed_steps(fmu_dir):
+    """Steps of TS, 2·TS, TS/2 and the shortfall, inputs changing from step to step: the pythonfmu ImuSensor
+    (which once refused any step after the first of another size) gives the native one's outputs."""
+    steps = [TS, 2 * TS, TS / 2, TS / 2, TS, 3 * TS, TS / 2, TS / 2, TS] * 5
+    rows = np.random.default_rng(3).normal(size=(len(steps), 6)) + [0, 0, 0, 0, 0, 9.8]
+    runs = []
+    for path in (fmu_dir / "ImuSensor.fmu", fmu_dir / "native" / "ImuSensor.fmu"):
+        master, t, out = Master(path, SENSOR_PARAMETERS), 0.0, []
+        for h, row in zip(steps, rows):
+            out.append(master.step(t, h, dict(zip(SENSOR_INPUTS, row))))
+            t += h
+        master.close()
+        runs.append(np.array(out))
+    np.testing.assert_allclose(runs[0], runs[1], rtol=0, atol=1e-12)

@@ -7,7 +7,7 @@
  * shortfall of picoseconds, half a sample) holds the outputs; several run in turn. Without one, each
  * step is a sample of its own length.
  * The pythonfmu ImuSensor (fmu_src/ImuSensor.py) runs the same C core with the same checks,
- * messages and statuses, but for the grid: with a latency it refuses a step of another size. */
+ * messages and statuses. */
 #include <math.h>
 #include <stdint.h>
 #include <string.h>

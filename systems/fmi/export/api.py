@@ -45,8 +45,7 @@ def export_fmu(system, path, *, x0=None, step: float | None = None, fmi_version:
     blocks means at rest on the first sample); step: the DefaultExperiment's step (s; default the
     system's dt, 0.01 s for a continuous one); a discrete system runs on the grid of its sample time from
     the start time: a communication step runs the samples it reaches, its inputs held, and one that
-    reaches none (a master's final shortfall of picoseconds) holds state and outputs (backend "python"
-    refuses a step other than dt);
+    reaches none (a master's final shortfall of picoseconds) holds state and outputs;
     fmi_version: "2.0" or "3.0"; platforms: "host", "all" or FMI 3.0 platform tuples
     (systems.fmi.platforms; needs the `platforms` extra); name: the model identifier (default the
     system's name); backend: "native" (C, no Python at run time) or "python" (pythonfmu: any discrete

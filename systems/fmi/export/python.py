@@ -42,7 +42,6 @@ def write_python(path: Path, name: str, system, x0, step, fmi_version: str) -> P
         (Path(tmp) / SYSTEM_FILE).write_bytes(cloudpickle.dumps((system, x0, float(dt))))
         built = FmuBuilder.build_FMU(script, dest=Path(tmp) / "out", project_files=[Path(tmp) / SYSTEM_FILE],
                                      needsExecutionTool="false", canGetAndSetFMUstate="true",
-                                     canSerializeFMUstate="true",
-                                     canHandleVariableCommunicationStepSize="false")  # dt only: PythonSystem
+                                     canSerializeFMUstate="true")
         guarded(Path(built), guard_binary())
         return copy_file(built, path)
