@@ -19,7 +19,7 @@ import math
 
 from attitude_fmu.blocks.pipeline.causal import valid_sample
 from attitude_fmu.blocks.pipeline.online import OnlineEstimator
-from attitude_fmu.blocks.stages.timing import GRID_MAX_SAMPLES, GRID_TOLERANCE, grid_samples
+from attitude_fmu.blocks.stages.timing import GRID_MAX_SAMPLES, grid_before, grid_samples
 from attitude_fmu.fmu_src.fmu_support import Fmi2Status, ProjectSlave
 from attitude_fmu.systems.fmi.interface.variables import attitude_estimator, tuning_parameters
 
@@ -64,7 +64,7 @@ class AttitudeEstimator(ProjectSlave):
         if n > GRID_MAX_SAMPLES:
             return self.fail(f"a step of {step_size!r} s reaches {n:.0f} samples of Ts = {Ts!r} s; one step runs "
                              f"{GRID_MAX_SAMPLES:.0f} at most: the estimate held")
-        first = start + math.floor((current_time - start) / Ts + GRID_TOLERANCE) * Ts
+        first = grid_before(start, Ts, current_time)
         return all(self._sample(first + k * Ts) for k in range(int(n)))
 
     def _sample(self, t: float) -> bool:

@@ -20,7 +20,7 @@ import numpy as np
 from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Real
 from pythonfmu.enums import Fmi2Status
 
-from attitude_fmu.blocks.stages.timing import GRID_MAX_SAMPLES, GRID_TOLERANCE, grid_samples
+from attitude_fmu.blocks.stages.timing import GRID_MAX_SAMPLES, grid_before, grid_samples
 from attitude_fmu.systems.fmi.export.python import SYSTEM_FILE
 
 
@@ -57,7 +57,7 @@ class PythonSystem(Fmi2Slave):
                      f"sample time {dt!r} s; one step runs {GRID_MAX_SAMPLES:.0f} at most: step refused",
                      Fmi2Status.error)
             return False
-        first = start + math.floor((current_time - start) / dt + GRID_TOLERANCE) * dt
+        first = grid_before(start, dt, current_time)
         x, y = self.x, self.y
         for k in range(int(n)):
             t = first + k * dt

@@ -250,22 +250,27 @@ def test_python_backend_exports_a_python_function_block(tmp_path):
     np.testing.assert_allclose(np.load(tmp_path / "y2.npy")[1::2], reference(system, u, dt), rtol=0, atol=TOLERANCE)
 
 
+def _export_command(spec: str, out, *flags, status: int = 0) -> subprocess.CompletedProcess:
+    """`attitude export spec --out out flags` in a process of its own, which ends with status."""
+    done = subprocess.run([sys.executable, "-m", "attitude_fmu.systems.cli.commands", "export", spec, "--out", str(out),
+                           *flags], capture_output=True, text=True)
+    assert done.returncode == status, done.stderr
+    return done
+
+
 def test_command_line_exports_a_file_the_test_writes(tmp_path):
     source = tmp_path / "plant.py"
     source.write_text("import control\n\n\ndef plant():\n"
                       "    return control.ss([[0.5]], [[1.0]], [[2.0]], [[0.0]], 0.1, name='plant'), [1.5]\n")
     out = tmp_path / "plant.fmu"
-    done = subprocess.run([sys.executable, "-m", "attitude_fmu.systems.cli.commands", "export", f"{source}:plant",
-                           "--out", str(out), "--fmi-version", "3.0"], capture_output=True, text=True)
-    assert done.returncode == 0, done.stderr
+    done = _export_command(f"{source}:plant", out, "--fmi-version", "3.0")
     assert done.stdout.strip() == str(out)
     system = control.ss([[0.5]], [[1.0]], [[2.0]], [[0.0]], 0.1, name="plant")
     u = np.ones((10, 1))
     np.testing.assert_allclose(fmu_outputs(out, u, 0.1, system), reference(system, u, 0.1, [1.5]), rtol=0,
                                atol=TOLERANCE)
     assert validate_fmu(str(out)) == []
-    missing = subprocess.run([sys.executable, "-m", "attitude_fmu.systems.cli.commands", "export", f"{source}:nothing",
-                              "--out", str(out)], capture_output=True, text=True)
+    missing = _export_command(f"{source}:nothing", out, status=2)
     assert missing.returncode != 0 and "defines no 'nothing'" in missing.stderr and "plant" in missing.stderr
 
 
@@ -397,10 +402,7 @@ def test_command_line_writes_scalar_parameters_in_fmi_3_0(tmp_path):
     source.write_text("import control\n\nplant = control.ss([[0.5, 0.1], [0.0, 0.3]], [[1.0], [0.0]], [[2.0, 1.0]], "
                       "[[0.0]], 0.1, name='plant')\n")
     out = tmp_path / "plant.fmu"
-    done = subprocess.run([sys.executable, "-m", "attitude_fmu.systems.cli.commands", "export", f"{source}:plant",
-                           "--out", str(out), "--fmi-version", "3.0", "--scalar-parameters"], capture_output=True,
-                          text=True)
-    assert done.returncode == 0, done.stderr
+    _export_command(f"{source}:plant", out, "--fmi-version", "3.0", "--scalar-parameters")
     md = read_model_description(str(out))
     names = {v.name for v in md.modelVariables}
     assert {"A[0,0]", "A[0,1]", "A[1,0]", "A[1,1]", "B[0,0]", "C[0,1]", "D[0,0]"} <= names and "A" not in names

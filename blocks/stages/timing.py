@@ -37,8 +37,9 @@ from attitude_fmu.blocks.tuning import STANDARD_GRAVITY
 STEP_TOLERANCE, same_step = _core.STEP_TOLERANCE, _core.same_step
 # an FMU with a sample time runs, in a communication step, grid_samples(start, Ts, t, h) samples: the
 # instants start + k·Ts its step reaches, up to GRID_TOLERANCE samples (a master that sums its steps falls
-# short by picoseconds), GRID_MAX_SAMPLES at most
+# short by picoseconds), GRID_MAX_SAMPLES at most, the first beginning at grid_before(start, Ts, t)
 GRID_TOLERANCE, GRID_MAX_SAMPLES, grid_samples = _core.GRID_TOLERANCE, _core.GRID_MAX_SAMPLES, _core.grid_samples
+grid_before = _core.grid_before
 MAX_LATENCY_S = _core.MAX_LATENCY_S  # s: the gyro's last rate is no guide to the orientation further ahead
 GYR_SAMPLES, ACC_SAMPLES = _core.GYR_SAMPLES, _core.ACC_SAMPLES  # the sample conventions (above), the usual first
 

@@ -151,7 +151,7 @@ static fmi2Status step(Fmi2Instance *instance, fmi2Real t, fmi2Real h) {
                  "the estimate held", float_repr(h, a), n, float_repr(Ts, b), GRID_MAX_SAMPLES);
         return fmi2Error;
     }
-    const double first = instance->start_time + floor((t - instance->start_time) / Ts + GRID_TOLERANCE) * Ts;
+    const double first = grid_before(instance->start_time, Ts, t);
     if (n <= 1.0) return n == 1.0 ? samples(instance, model, first, 1.0) : fmi2OK;
     /* a sample of Ts on inputs in every IMU's range keeps the outputs finite; a run of several falls back on
      * the state before it where one fails, a single one needs no copy (and is not slowed by it) */

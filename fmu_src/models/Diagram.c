@@ -387,8 +387,7 @@ static fmi2Status step(Fmi2Instance *instance, fmi2Real t, fmi2Real h)
                                                                                           leaves */
     memcpy(x, model->x, sizeof x);
     for (size_t i = 0; i < n_outputs; i++) y[i] = r[DIAGRAM_OUTPUT0 + i];
-    const double first = instance->start_time + (floor((t - instance->start_time) / DIAGRAM_DT +
-                                                       GRID_TOLERANCE)) * DIAGRAM_DT; /* the sample before */
+    const double first = grid_before(instance->start_time, DIAGRAM_DT, t); /* the sample before */
     for (double k = 0.0; k < n; k++)
         if (sample(instance, model, first + k * DIAGRAM_DT, DIAGRAM_DT) != fmi2OK) {
             memcpy(model->x, x, sizeof x);

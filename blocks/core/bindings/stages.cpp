@@ -255,6 +255,9 @@ void bind_stages(nb::module_ &m)
     m.def("grid_samples", &grid_samples, nb::arg("start"), nb::arg("Ts"), nb::arg("t"), nb::arg("h"),
           "The instants start + k*Ts (s, k >= 1) that a communication step from t over h (s) reaches, up to "
           "GRID_TOLERANCE samples: the samples an FMU with the sample time Ts runs in it, its inputs held.");
+    m.def("grid_before", &grid_before, nb::arg("start"), nb::arg("Ts"), nb::arg("t"),
+          "The grid's instant start + k*Ts (s) at t or, up to GRID_TOLERANCE, last before it: where the samples "
+          "a step from t runs begin.");
     m.def("carry_forward_rows", [](Rows4 quat, Rows3 gravity, const Rows3 &gyr, double latency) {
         size_t n = quat.shape(0);
         check_rows(gravity.shape(0), n, "gravity");

@@ -30,10 +30,20 @@ int same_step(double Ts, double reference)
     return fabs(Ts - reference) <= STEP_TOLERANCE * reference;
 }
 
+static double grid_index(double start, double Ts, double t)
+{
+    return floor((t - start) / Ts + GRID_TOLERANCE);
+}
+
 double grid_samples(double start, double Ts, double t, double h)
 {
-    double before = floor((t - start) / Ts + GRID_TOLERANCE), after = floor((t + h - start) / Ts + GRID_TOLERANCE);
+    double before = grid_index(start, Ts, t), after = grid_index(start, Ts, t + h);
     return after > before ? after - before : 0.0;
+}
+
+double grid_before(double start, double Ts, double t)
+{
+    return start + grid_index(start, Ts, t) * Ts;
 }
 
 Vec3 interval_mean(Vec3 before, Vec3 now)

@@ -32,6 +32,10 @@ int same_step(double Ts, double reference);
  * inputs held (none: its state and outputs held). Ts finite and positive; t and t + h finite. */
 double grid_samples(double start, double Ts, double t, double h);
 
+/* The grid's instant start + k*Ts (s) at t or, up to GRID_TOLERANCE, last before it: where the samples a step
+ * from t runs begin (the first ends one Ts later). */
+double grid_before(double start, double Ts, double t);
+
 /* The mean rate over the sample time between two point samples of it (rad/s): the trapezoid. */
 Vec3 interval_mean(Vec3 before, Vec3 now);
 
