@@ -8,7 +8,8 @@ ImuModel.apply_mag on the same samples. With a
 line; before the first step, the motion of the first step), and the first step's size is the
 sensor's sample time: later steps run on its grid from the start time
 (blocks.stages.timing.grid_samples), the samples a step reaches with its inputs held, none
-holding the outputs.
+holding the outputs. Before the first step (in Initialization Mode and after it) the outputs are
+the sensor's model of its inputs without noise, which a Jacobi master hands on before any step.
 """
 from __future__ import annotations
 
@@ -36,19 +37,37 @@ class ImuSensor(ProjectSlave):
 
     def initialise(self):
         try:
-            self.model = ImuModel(
-                delta_n=self.delta_n, acc_noise=self.acc_noise,
-                gyr_offset=(self.gyr_offset_x, self.gyr_offset_y, self.gyr_offset_z),
-                gyr_scale=tuple(tuple(getattr(self, f"gyr_scale_{row}_{c}") for c in "xyz") for row in "xyz"),
-                acc_offset=(self.acc_offset_x, self.acc_offset_y, self.acc_offset_z),
-                latency=self.latency, mag_noise=self.mag_noise,
-                mag_offset=(self.mag_offset_x, self.mag_offset_y, self.mag_offset_z),
-                mag_soft_iron=tuple(tuple(getattr(self, f"mag_soft_iron_{row}_{c}") for c in "xyz") for row in "xyz"),
-            )
+            self.model = self._model()
             self.rng, self.mag_rng = NoiseStream(self.seed, SENSOR), NoiseStream(self.seed, MAGNETOMETER)
             self.delay, self.step_size = None, None
         except ValueError as exc:
             self.fail(f"invalid parameter: {exc}")
+
+    def _model(self) -> ImuModel:
+        """The sensor of the parameters (ValueError: one refused)."""
+        return ImuModel(
+            delta_n=self.delta_n, acc_noise=self.acc_noise,
+            gyr_offset=(self.gyr_offset_x, self.gyr_offset_y, self.gyr_offset_z),
+            gyr_scale=tuple(tuple(getattr(self, f"gyr_scale_{row}_{c}") for c in "xyz") for row in "xyz"),
+            acc_offset=(self.acc_offset_x, self.acc_offset_y, self.acc_offset_z),
+            latency=self.latency, mag_noise=self.mag_noise,
+            mag_offset=(self.mag_offset_x, self.mag_offset_y, self.mag_offset_z),
+            mag_soft_iron=tuple(tuple(getattr(self, f"mag_soft_iron_{row}_{c}") for c in "xyz") for row in "xyz"),
+        )
+
+    def start_values(self):
+        """Before the first step: the sensor's model of its inputs as they are, with no noise (no
+        sample is drawn before a step)."""
+        try:
+            model = self._model()
+            NoiseStream(self.seed, SENSOR)  # the seed's check
+        except ValueError:
+            return None
+        gyr, acc = model.measure((self.omega_x, self.omega_y, self.omega_z), (self.f_x, self.f_y, self.f_z),
+                                 np.zeros(6), 1.0)
+        mag = model.measure_mag((self.m_x, self.m_y, self.m_z), np.zeros(3), 1.0)
+        return dict(zip(("gyr_x", "gyr_y", "gyr_z", "acc_x", "acc_y", "acc_z", "mag_x", "mag_y", "mag_z"),
+                        (float(v) for v in (*gyr, *acc, *mag))))
 
     def do_step(self, current_time, step_size):
         if self.error is not None:

@@ -1,7 +1,9 @@
 """MotionProfile.fmu: the project's motion profiles with exact truth (systems.simulation.motion).
 
 Each doStep(t, h) outputs the interval (t, t+h]: the mean angular rate over it, and the
-specific force, magnetic field and true orientation at t+h. Profile parameters are
+specific force, magnetic field and true orientation at t+h; before the first step (in
+Initialization Mode and after it) the outputs are the motion's at the start time, that
+instant's rate and specific force. Profile parameters are
 named <profile>_<parameter> and start at the profile's defaults; profile is an Enumeration of
 the profiles' names.
 """
@@ -24,18 +26,36 @@ class MotionProfile(ProjectSlave):
 
     def initialise(self):
         try:
-            prof = profile(self.item("profile"))
-            motion = prof.motion({p.name: getattr(self, f"{prof.name}_{p.name}") for p in prof.params}, g=self.g)
-            self.stream = motion.stream(self.seed)
+            self.stream = self._stream()
         except ValueError as exc:
             self.fail(f"invalid parameter: {exc}")
+
+    def _stream(self):
+        """The profile's motion from the parameters, sample by sample (ValueError: one refused)."""
+        prof = profile(self.item("profile"))
+        motion = prof.motion({p.name: getattr(self, f"{prof.name}_{p.name}") for p in prof.params}, g=self.g)
+        return motion.stream(self.seed)
+
+    def start_values(self):
+        """The motion at the start time: that instant's rate and specific force (a step of 0 s)."""
+        try:
+            return self._outputs(*self._stream().step(self.start_time, 0.0))
+        except ValueError:
+            return None
+
+    @staticmethod
+    def _outputs(gyr, f, q) -> dict[str, float]:
+        names = ("omega_x", "omega_y", "omega_z", "f_x", "f_y", "f_z", "qt_w", "qt_x", "qt_y", "qt_z",
+                 "m_x", "m_y", "m_z")
+        return dict(zip(names, (float(v) for v in (*gyr, *f, *q, *earth_field(q)))))
 
     def do_step(self, current_time, step_size):
         if self.error is not None:
             return self.refuse_step()
-        gyr, f, q = self.stream.step(current_time + step_size, step_size)
-        self.omega_x, self.omega_y, self.omega_z = (float(v) for v in gyr)
-        self.f_x, self.f_y, self.f_z = (float(v) for v in f)
-        self.qt_w, self.qt_x, self.qt_y, self.qt_z = (float(v) for v in q)
-        self.m_x, self.m_y, self.m_z = (float(v) for v in earth_field(q))
+        try:
+            outputs = self._outputs(*self.stream.step(current_time + step_size, step_size))
+        except ValueError as exc:  # the human motion refuses the interval, or the arithmetic overflows
+            return self.fail(str(exc))
+        for name, value in outputs.items():
+            setattr(self, name, value)
         return True

@@ -77,14 +77,40 @@ class ProjectSlave(Fmi2Slave):
         for name, value in internal.items():
             setattr(self, name, value)
 
+    initialising = False  # in Initialization Mode
+
+    def enter_initialization_mode(self):
+        self.initialising = True
+
     def exit_initialization_mode(self):
+        self.initialising = False
         if self.error is not None:
             self.fail(self.error)
             return
         self.initialise()
+        if self.error is None:
+            for name, value in (self.start_values() or {}).items():
+                setattr(self, name, value)
 
     def initialise(self):
         """Build the model from the parameters; an invalid one: fail(message)."""
+
+    def start_values(self) -> dict[str, float] | None:
+        """The calculated outputs (initial "calculated": a motion's or a sensor's, which a Jacobi master
+        reads before the first step) at the start time, by name, from the parameters and inputs as they
+        are, the FMU's state left as it is; None where the parameters are refused (nothing logged:
+        fmi2ExitInitializationMode says why) or the FMU has none. Read by each get in Initialization
+        Mode and set at its exit, as the native FMUs do (fmu_src/fmi2/fmi2_model.h: start)."""
+        return None
+
+    def _calculated(self, name: str) -> float:
+        """A calculated output's getter: in Initialization Mode its value at the start time, later the
+        attribute."""
+        if self.initialising and self.error is None:
+            values = self.start_values()
+            if values is not None:
+                return values[name]
+        return getattr(self, name)
 
     def to_xml(self, model_options=None) -> Element:
         """pythonfmu's model description with the variables' sections, the default experiment and
@@ -128,6 +154,8 @@ class ProjectSlave(Fmi2Slave):
             extra = {"initial": Fmi2Initial[v.initial]} if v.initial else {}
             if v.type == ENUMERATION:  # pythonfmu has no Enumeration: an Integer whose sets are checked
                 extra["setter"] = lambda value, v=v: self._set_item(v, value)
+            if v.initial == "calculated":
+                extra["getter"] = lambda v=v: self._calculated(v.name)
             self.register_variable(_PYTHONFMU_TYPES[v.type](
                 v.name, causality=Fmi2Causality[v.causality], variability=Fmi2Variability[v.variability],
                 description=v.description, **extra), nested=False)

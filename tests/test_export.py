@@ -223,7 +223,7 @@ def test_python_backend_exports_a_python_function_block(tmp_path):
     """A control.nlsys of Python functions through pythonfmu (with the project's guard): run by fmpy in a
     process of its own (pythonfmu's library may not be unloaded from a process that goes on), it equals
     input_output_response; in steps of dt/2 (each input held over two) it runs on the grid of dt and gives
-    the same outputs after every second step."""
+    the same outputs after every second step; before the first step its output is sample 0's."""
     dt = 0.1
     system = control.nlsys(lambda t, x, u, p: 0.5 * x + u[:1], lambda t, x, u, p: 2 * np.tanh(x[0] + u),
                            inputs=["a"], outputs=["b"], states=1, dt=dt, name="saturating")
@@ -248,6 +248,22 @@ def test_python_backend_exports_a_python_function_block(tmp_path):
         assert run.returncode == 0, run.stderr[-3000:]
     np.testing.assert_allclose(np.load(tmp_path / "y1.npy"), reference(system, u, dt), rtol=0, atol=TOLERANCE)
     np.testing.assert_allclose(np.load(tmp_path / "y2.npy")[1::2], reference(system, u, dt), rtol=0, atol=TOLERANCE)
+    # before the first step, in Initialization Mode and after it: sample 0's output, 2 tanh(x0 + u) at x0 = 0
+    script = ("import os, fmpy\n"
+              "from fmpy.fmi2 import FMU2Slave\n"
+              "md = fmpy.read_model_description('saturating.fmu')\n"
+              "vr = {v.name: v.valueReference for v in md.modelVariables}\n"
+              "fmu = FMU2Slave(guid=md.guid, unzipDirectory=fmpy.extract('saturating.fmu'),\n"
+              "                modelIdentifier=md.coSimulation.modelIdentifier, instanceName='start')\n"
+              "fmu.instantiate(); fmu.setupExperiment(startTime=0.0); fmu.enterInitializationMode()\n"
+              "fmu.setReal([vr['a']], [0.7])\n"
+              "during = fmu.getReal([vr['b']])[0]\n"
+              "fmu.exitInitializationMode()\n"
+              "print(during, fmu.getReal([vr['b']])[0], flush=True)\n"
+              "os._exit(0)\n")
+    run = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr[-3000:]
+    np.testing.assert_allclose([float(v) for v in run.stdout.split()], [2 * np.tanh(0.7)] * 2, rtol=0, atol=1e-15)
 
 
 def _export_command(spec: str, out, *flags, status: int = 0) -> subprocess.CompletedProcess:

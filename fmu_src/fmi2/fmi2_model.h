@@ -7,9 +7,10 @@
  * variable's causality and variability forbid: fmi2Error with a log message), saves and
  * serialises FMU states, and logs through the importer's callback. A model file (models/<Name>.c)
  * defines `fmi2_model`: its variables (a table generated from the project's table of FMU
- * variables, systems/fmi/interface/variables.py, into <Name>_variables.h), the size of its own state and three
- * functions: called at fmi2ExitInitializationMode, at each fmi2DoStep, and on an FMU state before
- * fmi2SetFMUstate or fmi2DeSerializeFMUstate takes it (fmi2/fmu_state.h). */
+ * variables, systems/fmi/interface/variables.py, into <Name>_variables.h), the size of its own state and its
+ * functions: called at fmi2ExitInitializationMode, at each fmi2DoStep, on an FMU state before
+ * fmi2SetFMUstate or fmi2DeSerializeFMUstate takes it (fmi2/fmu_state.h), and for the outputs at the start
+ * time. */
 #ifndef FMI2_MODEL_H
 #define FMI2_MODEL_H
 
@@ -68,6 +69,12 @@ typedef struct {
      * every field is in its range and whatever is derived from the parameters is configured's, else
      * -1 with the reason in message (size bytes). It reads the bytes only. */
     int (*validate)(const void *state, const void *configured, char *message, size_t size);
+    /* The outputs whose initial is "calculated" (those of a motion or a sensor, which a Jacobi master reads before
+     * the first step): their values at the start time (instance->start_time) from the parameters and inputs as
+     * they are, written by a model initialise made (its state left as it is). Called at the exit of
+     * Initialization Mode and, on a scratch copy of the instance, at each get within it
+     * (fmi2/instance.h: fmi2_initialise, fmi2_start_outputs). NULL: the outputs start exact. */
+    void (*start)(Fmi2Instance *instance);
 } Fmi2Model;
 
 extern const Fmi2Model fmi2_model; /* defined by the model file */

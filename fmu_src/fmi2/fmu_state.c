@@ -96,21 +96,11 @@ static int model_check(const Fmi2Instance *view, int phase, char *reason, size_t
         strncpy(reason, "the model's state of an instance not initialised is not empty", size - 1);
         return -1;
     }
-    unsigned char *data = malloc(view->data_size);
-    if (!data) {
-        strncpy(reason, "out of memory", size - 1);
-        return -1;
-    }
-    memcpy(data, view->data, view->data_size);
     Fmi2Instance scratch;
-    memset(&scratch, 0, sizeof scratch); /* no logger: the initialisation's messages go nowhere */
-    fmi2_instance_bind(&scratch, data);
-    memset(scratch.state, 0, fmi2_model.state_size);
-    scratch.phase = FMI2_INITIALIZATION_MODE;
     int result = -1;
-    if (fmi2_model.initialise(&scratch) >= fmi2Error) strncpy(reason, "the model refuses its parameters", size - 1);
-    else result = fmi2_model.validate(view->state, scratch.state, reason, size);
-    free(data);
+    if (fmi2_scratch(view, &scratch) < fmi2Error) result = fmi2_model.validate(view->state, scratch.state, reason, size);
+    else strncpy(reason, scratch.data ? "the model refuses its parameters" : "out of memory", size - 1);
+    free(scratch.data);
     return result;
 }
 

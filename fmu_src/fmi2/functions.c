@@ -78,9 +78,7 @@ fmi2Status fmi2EnterInitializationMode(fmi2Component c) {
 
 fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
     INSTANCE(c, "fmi2ExitInitializationMode", FMI2_IN(FMI2_INITIALIZATION_MODE));
-    fmi2Status status = fmi2_model.initialise(instance);
-    if (status < fmi2Error) instance->phase = FMI2_STEP_COMPLETE;
-    return fmi2_leave(instance, status);
+    return fmi2_leave(instance, fmi2_initialise(instance));
 }
 
 fmi2Status fmi2Terminate(fmi2Component c) {

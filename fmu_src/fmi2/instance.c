@@ -171,6 +171,40 @@ void fmi2_instance_free(Fmi2Instance *instance) {
     free(instance);
 }
 
+fmi2Status fmi2_scratch(const Fmi2Instance *view, Fmi2Instance *scratch) {
+    memset(scratch, 0, sizeof *scratch); /* no logger: the initialisation's messages go nowhere */
+    unsigned char *data = malloc(view->data_size ? view->data_size : 1);
+    if (!data) return fmi2Error;
+    memcpy(data, view->data, view->data_size);
+    fmi2_instance_bind(scratch, data);
+    memset(scratch->state, 0, fmi2_model.state_size);
+    scratch->phase = FMI2_INITIALIZATION_MODE;
+    scratch->time = scratch->start_time = view->start_time;
+    return fmi2_model.initialise(scratch);
+}
+
+fmi2Status fmi2_initialise(Fmi2Instance *instance) {
+    fmi2Status status = fmi2_model.initialise(instance);
+    if (status >= fmi2Error) return status;
+    if (fmi2_model.start) fmi2_model.start(instance);
+    instance->phase = FMI2_STEP_COMPLETE;
+    return status;
+}
+
+void fmi2_start_outputs(Fmi2Instance *instance) {
+    if (!fmi2_model.start || instance->phase != FMI2_INITIALIZATION_MODE) return;
+    Fmi2Instance scratch;
+    if (fmi2_scratch(instance, &scratch) < fmi2Error) {
+        fmi2_model.start(&scratch);
+        for (size_t vr = 0; vr < fmi2_model.n_variables; vr++) {
+            const Fmi2Variable *v = &fmi2_model.variables[vr];
+            if (v->type == FMI2_REAL && v->causality == FMI2_OUTPUT && v->initial == FMI2_CALCULATED)
+                instance->reals[v->index] = scratch.reals[v->index];
+        }
+    }
+    free(scratch.data);
+}
+
 int fmi2_enter(Fmi2Instance *instance, const char *call, unsigned allowed) {
     instance->logged = fmi2OK;
     fmi2_log(instance, fmi2OK, "%s", call);

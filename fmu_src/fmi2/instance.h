@@ -32,6 +32,18 @@ void fmi2_instance_bind(Fmi2Instance *instance, unsigned char *data);
 /* Back to FMI2_INSTANTIATED: start values, the model's state zero. */
 void fmi2_instance_reset(Fmi2Instance *instance);
 
+/* scratch: a copy of view's values (its own data block, which the caller frees: free(scratch->data), NULL where
+ * it could not be had), with no logger, in Initialization Mode at view's start time, initialised by the model
+ * from them: the model's initialise's status (fmi2Error where memory ran out). */
+fmi2Status fmi2_scratch(const Fmi2Instance *view, Fmi2Instance *scratch);
+/* fmi2ExitInitializationMode's and fmi3ExitInitializationMode's work: the model initialised from the
+ * parameters, then the outputs at the start time (Fmi2Model.start); step mode unless it refused. */
+fmi2Status fmi2_initialise(Fmi2Instance *instance);
+/* A get in Initialization Mode: the calculated outputs at the start time from the values as they are
+ * (Fmi2Model.start on a scratch copy); where the model refuses its parameters they keep their values,
+ * and fmi2ExitInitializationMode says why. */
+void fmi2_start_outputs(Fmi2Instance *instance);
+
 /* The start of a call: 1 if the instance's state allows it (allowed: FMI2_IN bits), else 0 with
  * an error logged and the instance in FMI2_ERROR. Traces the call (category logCalls). */
 int fmi2_enter(Fmi2Instance *instance, const char *call, unsigned allowed);

@@ -77,6 +77,7 @@ fmi2Status fmi2_get_values(Fmi2Instance *instance, const char *call, unsigned ty
                  (unsigned long)n);
         return fmi2Error;
     }
+    if (types & FMI2_TYPES(FMI2_REAL)) fmi2_start_outputs(instance); /* in Initialization Mode */
     for (size_t i = 0; i < n; i++) {
         const Fmi2Variable *v = variable(instance, call, types, vr[i]);
         if (!v) return fmi2Error;

@@ -109,9 +109,7 @@ fmi3Status fmi3EnterInitializationMode(fmi3Instance c, fmi3Boolean toleranceDefi
 
 fmi3Status fmi3ExitInitializationMode(fmi3Instance c) {
     INSTANCE(c, "fmi3ExitInitializationMode", FMI2_IN(FMI2_INITIALIZATION_MODE));
-    fmi2Status status = fmi2_model.initialise(instance);
-    if (status < fmi2Error) instance->phase = FMI2_STEP_COMPLETE;
-    return leave(instance, status);
+    return leave(instance, fmi2_initialise(instance));
 }
 
 fmi3Status fmi3Terminate(fmi3Instance c) {

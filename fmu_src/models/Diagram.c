@@ -2,7 +2,8 @@
  * blocks, their connections and the initial state the exporter wrote into diagram_tables.h
  * (diagram/diagram.h), each block stepped by its kind's C step (diagram/kinds.h). After the step that
  * ends at t[k+1] the outputs are the diagram's at sample k, as control.input_output_response gives
- * them, the inputs of sample k held over the step. A discrete diagram (DIAGRAM_DT > 0) runs on the grid of
+ * them, the inputs of sample k held over the step; before the first step (in Initialization Mode and after it),
+ * sample 0's, from the initial state and the inputs as they are. A discrete diagram (DIAGRAM_DT > 0) runs on the grid of
  * its sample time from the start time (timing.h: grid_samples): a step runs the samples it reaches, its inputs held,
  * none (a master's shortfall of picoseconds, half a sample) holding state and outputs, several in turn; a
  * continuous one (LTI blocks only) takes any step, its blocks held over it by zero-order hold. */
@@ -315,12 +316,11 @@ static size_t not_finite(const Model *model)
     return n_blocks;
 }
 
-/* one sample of the diagram from t over h (s): its next state and outputs taken where every value is
- * finite, else fmi2Error with both as they were */
-static fmi2Status sample(Fmi2Instance *instance, Model *model, double t, double h)
+/* one sample of the diagram at its state and the inputs as they are: the blocks' outputs and next state, the
+ * diagram's outputs (model->signals, next, outputs); the block whose outputs or next state are not finite,
+ * n_blocks + 1 where the diagram's outputs are not, else n_blocks */
+static size_t evaluate(Model *model, const fmi2Real *r)
 {
-    fmi2Real *r = instance->reals;
-    char a[FLOAT_REPR_SIZE], name[64];
     /* 1: the blocks without feedthrough, their outputs from their state */
     for (size_t p = 0; p < n_blocks; p++) {
         size_t b = DIAGRAM_ORDER[p];
@@ -349,16 +349,26 @@ static fmi2Status sample(Fmi2Instance *instance, Model *model, double t, double 
         lti_update(&model->coef[b].lti, &lti, model->x + block->state, model->inputs + block->input,
                    model->next + block->state);
     }
-    /* 4: the diagram's outputs; the next state taken where every value is finite */
+    /* 4: the diagram's outputs */
     for (size_t i = 0; i < n_outputs; i++) model->outputs[i] = 0.0;
     for (size_t k = 0; k < n_output_terms; k++) {
         const DiagramTerm *term = &DIAGRAM_OUTPUT_TERMS[k];
         model->outputs[term->to] += term->gain * source_value(model, r, term);
     }
     size_t refused = not_finite(model);
-    int outputs_finite = 1;
-    for (size_t i = 0; i < n_outputs; i++) outputs_finite = outputs_finite && isfinite(model->outputs[i]);
-    if (refused < n_blocks || !outputs_finite) {
+    for (size_t i = 0; i < n_outputs && refused == n_blocks; i++)
+        if (!isfinite(model->outputs[i])) refused = n_blocks + 1;
+    return refused;
+}
+
+/* one sample of the diagram from t over h (s): its next state and outputs taken where every value is
+ * finite, else fmi2Error with both as they were */
+static fmi2Status sample(Fmi2Instance *instance, Model *model, double t, double h)
+{
+    fmi2Real *r = instance->reals;
+    char a[FLOAT_REPR_SIZE], name[64];
+    size_t refused = evaluate(model, r);
+    if (refused != n_blocks) {
         if (refused < n_blocks) block_name(&DIAGRAM_BLOCKS[refused], name);
         fmi2_log(instance, fmi2Error, "t=%g: a step of %s s leaves %s%s not finite; the diagram's state and outputs "
                  "held", t, float_repr(h, a), refused < n_blocks ? "the outputs or the next state of block " :
@@ -368,6 +378,15 @@ static fmi2Status sample(Fmi2Instance *instance, Model *model, double t, double 
     for (size_t i = 0; i < n_states; i++) model->x[i] = model->next[i];
     for (size_t i = 0; i < n_outputs; i++) r[DIAGRAM_OUTPUT0 + i] = model->outputs[i];
     return fmi2OK;
+}
+
+/* before the first step: the outputs of sample 0, at the initial state (DIAGRAM_X0) and the inputs as they are,
+ * the state left as it is (the first step gives them again); where they are not finite, as they were */
+static void start(Fmi2Instance *instance)
+{
+    Model *model = instance->state;
+    if (evaluate(model, instance->reals) != n_blocks) return;
+    for (size_t i = 0; i < n_outputs; i++) instance->reals[DIAGRAM_OUTPUT0 + i] = model->outputs[i];
 }
 
 static fmi2Status step(Fmi2Instance *instance, fmi2Real t, fmi2Real h)
@@ -429,5 +448,5 @@ static int validate(const void *state, const void *configured, char *message, si
 
 const Fmi2Model fmi2_model = {
     MODEL_IDENTIFIER, MODEL_GUID, MODEL_VARIABLES, N_VARIABLES, N_REALS, N_INTEGERS, N_BOOLEANS, N_STRINGS,
-    MODEL_LOG_CATEGORIES, N_LOG_CATEGORIES, sizeof(Model), initialise, step, validate,
+    MODEL_LOG_CATEGORIES, N_LOG_CATEGORIES, sizeof(Model), initialise, step, validate, start,
 };

@@ -5,7 +5,8 @@
  * With a latency the first step's size is the sensor's sample time, and later steps run on its grid
  * from the start time (timing.h: grid_samples): the samples a step reaches, its inputs held; none (a master's
  * shortfall of picoseconds, half a sample) holds the outputs; several run in turn. Without one, each
- * step is a sample of its own length.
+ * step is a sample of its own length. Before the first step (in Initialization Mode and after it) the outputs
+ * are the sensor's model of its inputs without noise, which a Jacobi master hands on before any step.
  * The pythonfmu ImuSensor (fmu_src/ImuSensor.py) runs the same C core with the same checks,
  * messages and statuses. */
 #include <math.h>
@@ -119,7 +120,17 @@ static fmi2Status step(Fmi2Instance *instance, fmi2Real t, fmi2Real h) {
     return fmi2OK;
 }
 
+/* before the first step: the sensor's model of its inputs as they are, with no noise (no sample is drawn
+ * before a step; with a latency, the inputs are those the delay line starts filled with) */
+static void start(Fmi2Instance *instance) {
+    const Model *model = instance->state;
+    fmi2Real *r = instance->reals;
+    const double none[SENSOR_WIDTH > MAGNETOMETER_WIDTH ? SENSOR_WIDTH : MAGNETOMETER_WIDTH] = {0.0};
+    imu_measure(&model->params, &r[REAL_omega_x], &r[REAL_f_x], none, 1.0, &r[REAL_gyr_x], &r[REAL_acc_x]);
+    imu_measure_mag(&model->params, &r[REAL_m_x], none, 1.0, &r[REAL_mag_x]);
+}
+
 const Fmi2Model fmi2_model = {
     MODEL_IDENTIFIER, MODEL_GUID, MODEL_VARIABLES, N_VARIABLES, N_REALS, N_INTEGERS, N_BOOLEANS, N_STRINGS,
-    MODEL_LOG_CATEGORIES, N_LOG_CATEGORIES, sizeof(Model), initialise, step, validate,
+    MODEL_LOG_CATEGORIES, N_LOG_CATEGORIES, sizeof(Model), initialise, step, validate, start,
 };

@@ -2,7 +2,9 @@
  * generated from systems/fmi/interface/simulation_variables.py) onto the simulation's motions: the human motion's
  * stream on its grid (human_motion.h) and the closed forms (closed_form.h), both functions of time
  * alone. doStep(t, h) outputs the interval (t, t+h]: the rate that turns the orientation over it, the
- * specific force of its mean acceleration, field and orientation at t+h. A profile's parameters are the
+ * specific force of its mean acceleration, field and orientation at t+h; before the first step (in
+ * Initialization Mode and after it) the outputs are the motion's at the start time, that instant's rate and
+ * specific force, which a Jacobi master hands on before any step. A profile's parameters are the
  * Real parameters named <profile>_<parameter>, in the order of systems/simulation/profile_table.py,
  * checked against their plausible ranges at initialisation (profile_params.h).
  * The pythonfmu MotionProfile (fmu_src/MotionProfile.py) runs the same C core with the same checks,
@@ -103,35 +105,57 @@ static int validate(const void *state, const void *configured, char *message, si
     return human_stream_validate(&model->stream, &own->stream, message, size);
 }
 
-/* the outputs of the interval (t, t + h]; where the step's arithmetic leaves them not finite, or the human
- * motion refuses the step, fmi2Error with the reason and the outputs as they were */
-static fmi2Status step(Fmi2Instance *instance, fmi2Real t, fmi2Real h) {
-    Model *model = instance->state;
-    fmi2Real *r = instance->reals;
-    double out[HUMAN_N_OUT + 3];
-    char message[MESSAGE_SIZE], a[FLOAT_REPR_SIZE], b[FLOAT_REPR_SIZE];
-    const HumanStream before = model->stream; /* what a step the arithmetic cannot take leaves */
+/* the outputs of the interval (t, t + h] from the stream (a human motion's) or the closed form: 0, or -1 with the
+ * reason in message where the human motion refuses the interval or the arithmetic leaves them not finite; h = 0:
+ * the instant t */
+static int motion_at(Model *model, HumanStream *stream, double t, double h, double out[HUMAN_N_OUT + 3],
+                     char *message, size_t size) {
+    char a[FLOAT_REPR_SIZE], b[FLOAT_REPR_SIZE];
     if (model->human) {
-        if (human_stream_step(&model->stream, t, t + h, out, message, sizeof message) != 0) {
-            fmi2_log(instance, fmi2Error, "%s", message);
-            return fmi2Error;
-        }
+        if (human_stream_step(stream, t, t + h, out, message, size) != 0) return -1;
     } else closed_form_at(&model->closed, t + h, h, out, out + 3, out + 6);
     earth_field_in_sensor(out + 6, out + HUMAN_N_OUT);
     for (int i = 0; i < HUMAN_N_OUT + 3; i++)
-        if (!isfinite(out[i])) {
-            model->stream = before;
-            fmi2_log(instance, fmi2Error, "a step of %s s to %s s overflows the motion's arithmetic",
-                     float_repr(h, a), float_repr(t + h, b));
-            return fmi2Error;
-        }
+        if (!isfinite(out[i]))
+            return refuse(message, size, "a step of %s s to %s s overflows the motion's arithmetic", float_repr(h, a),
+                          float_repr(t + h, b));
+    return 0;
+}
+
+static void write_outputs(fmi2Real *r, const double out[HUMAN_N_OUT + 3]) {
     for (int i = 0; i < 3; i++) r[REAL_omega_x + i] = out[i], r[REAL_f_x + i] = out[3 + i];
     for (int i = 0; i < 4; i++) r[REAL_qt_w + i] = out[6 + i];
     for (int i = 0; i < 3; i++) r[REAL_m_x + i] = out[HUMAN_N_OUT + i];
+}
+
+/* the outputs of the interval (t, t + h]; where the step's arithmetic leaves them not finite, or the human
+ * motion refuses the step, fmi2Error with the reason and the outputs and the stream as they were */
+static fmi2Status step(Fmi2Instance *instance, fmi2Real t, fmi2Real h) {
+    Model *model = instance->state;
+    double out[HUMAN_N_OUT + 3];
+    char message[MESSAGE_SIZE];
+    HumanStream next = model->stream;
+    if (motion_at(model, &next, t, h, out, message, sizeof message) != 0) {
+        fmi2_log(instance, fmi2Error, "%s", message);
+        return fmi2Error;
+    }
+    model->stream = next;
+    write_outputs(instance->reals, out);
     return fmi2OK;
+}
+
+/* the motion at the start time: the rate and specific force at that instant (a step of 0 s), on a copy of the
+ * stream; where its arithmetic fails, the outputs as they were (the first step says why) */
+static void start(Fmi2Instance *instance) {
+    Model *model = instance->state;
+    double out[HUMAN_N_OUT + 3];
+    char message[MESSAGE_SIZE];
+    HumanStream copy = model->stream;
+    if (motion_at(model, &copy, instance->start_time, 0.0, out, message, sizeof message) == 0)
+        write_outputs(instance->reals, out);
 }
 
 const Fmi2Model fmi2_model = {
     MODEL_IDENTIFIER, MODEL_GUID, MODEL_VARIABLES, N_VARIABLES, N_REALS, N_INTEGERS, N_BOOLEANS, N_STRINGS,
-    MODEL_LOG_CATEGORIES, N_LOG_CATEGORIES, sizeof(Model), initialise, step, validate,
+    MODEL_LOG_CATEGORIES, N_LOG_CATEGORIES, sizeof(Model), initialise, step, validate, start,
 };

@@ -20,5 +20,5 @@ static fmi2Status step(Fmi2Instance *instance, fmi2Real t, fmi2Real h) {
 
 const Fmi2Model fmi2_model = {
     MODEL_IDENTIFIER, MODEL_GUID, MODEL_VARIABLES, N_VARIABLES, N_REALS, N_INTEGERS, N_BOOLEANS, N_STRINGS,
-    MODEL_LOG_CATEGORIES, N_LOG_CATEGORIES, 0, initialise, step, validate,
+    MODEL_LOG_CATEGORIES, N_LOG_CATEGORIES, 0, initialise, step, validate, NULL,
 };

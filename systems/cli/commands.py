@@ -332,6 +332,11 @@ def build_parser() -> argparse.ArgumentParser:
     _add_cluster_flags(vf, "co-simulations (profile × method)")
     vf.add_argument("--python", action="store_true", help="also run the pythonfmu chain and hold its estimator "
                     "outputs to the native chain's within 1e-9 (minutes instead of seconds)")
+    vf.add_argument("--master", choices=("gauss-seidel", "jacobi"), default="gauss-seidel",
+                    help="the co-simulation master: gauss-seidel (the default: each FMU takes its sources' outputs of "
+                    "the same step) or jacobi (as OMSimulator and libcosim step: outputs of the step before, inputs "
+                    "set in Initialization Mode, time summed with a last step of the shortfall; the estimator's "
+                    "inputs 2 steps late, taken off against the truth)")
     vf.add_argument("--platforms", default="host", help="the native FMUs hold these platforms' binaries too, cross-"
                     "compiled where missing (needs ziglang): host (the default), all, or a comma-separated list of "
                     "x86_64-linux, aarch64-linux, x86_64-windows, x86_64-darwin, aarch64-darwin; the chain runs "
@@ -730,7 +735,8 @@ def cmd_verify(args) -> int:
 
     fmu_dir = _verified_fmus(args)
     with _jobs(args) as jobs:
-        rows = verify(fmu_dir, args.profile, args.method, python=args.python, jobs=jobs, platforms=args.platforms)
+        rows = verify(fmu_dir, args.profile, args.method, python=args.python, jobs=jobs, platforms=args.platforms,
+                      master=args.master)
     if args.json:
         print(json.dumps({"rows": rows}, indent=2))
     else:

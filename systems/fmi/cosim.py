@@ -116,14 +116,21 @@ class _Component:
         self.inputs: list[tuple[str, str, str]] = []  # (own input, source component, source output)
 
     def start(self, parameters, start_time: float):
+        """Instantiated, in Initialization Mode at start_time (s), its parameters set."""
         self.fmu.instantiate()
         self.fmu.setupExperiment(startTime=start_time)
         self.fmu.enterInitializationMode()
         for p in parameters:  # an SSD's values are text (an Enumeration's: its item's value or name)
             variable = self.variable(p.name, "a parameter binding")
             set_value(self.fmu, variable, int(p.value) if p.type == "Integer" else p.value)
-        self.fmu.exitInitializationMode()
         self.input_vr = [self.variables[name].valueReference for name, _, _ in self.inputs]
+
+    def output_values(self) -> list[float]:
+        """Its Real and Boolean outputs (Booleans as 0 or 1), in the order real_out + bool_out."""
+        values = list(self.fmu.getReal(self.real_out_vr))
+        if self.bool_out_vr:
+            values += [float(b) for b in self.fmu.getBoolean(self.bool_out_vr)]
+        return values
 
     def variable(self, name: str, what: str, causality: str | None = None):
         """The variable name (of causality, where given) of fmpy's model description; ValueError naming
@@ -139,8 +146,20 @@ class _Component:
         self.fmu.freeInstance()
 
 
-def cosimulate(ssp_path, stop_time: float, step_size: float, progress=None) -> dict[str, np.ndarray]:
+MASTERS = ("gauss-seidel", "jacobi")
+
+
+def cosimulate(ssp_path, stop_time: float, step_size: float, progress=None,
+               master: str = "gauss-seidel") -> dict[str, np.ndarray]:
     """Run the SSP from 0 to stop_time (s) with a fixed step (s).
+
+    master: "gauss-seidel" (the default) steps the components in the order of their connections at
+    the times k·step_size, each taking its sources' outputs of the same step. "jacobi" steps as
+    strict masters do (OMSimulator's and libcosim's fixed-step algorithms): in Initialization Mode
+    each component's inputs are its sources' outputs read there (in the order of the connections);
+    every step then hands on the outputs of the step before (a component k connections from a
+    source sees it k steps late); time is summed step by step, and a last step of the shortfall
+    (picoseconds) reaches stop_time.
 
     Returns "time" (end of each step) and every output as "component.variable", one
     value per step. progress(fraction) is called about every 1 % when given. ValueError, in
@@ -150,13 +169,15 @@ def cosimulate(ssp_path, stop_time: float, step_size: float, progress=None) -> d
     connections or parameters; RuntimeError for a component that fails to load or step.
     Nothing extracted outlives the call.
     """
+    if master not in MASTERS:
+        raise ValueError(f"the master must be one of {', '.join(MASTERS)}, got {master!r}")
     n = step_count(stop_time, step_size)
     try:
         ssd = read_ssd(str(ssp_path))
     except Exception as exc:  # zipfile's, lxml's and fmpy's own (a plain Exception) refusals
         raise ValueError(f"{ssp_path} is no SSP fmpy can read: {one_line(exc)}") from None
     with tempfile.TemporaryDirectory(prefix="attitude_fmu_ssp_") as tmp:
-        return _run_ssd(ssd, ssp_path, Path(tmp), n, step_size, progress)
+        return _run_ssd(ssd, ssp_path, Path(tmp), n, step_size, progress, master == "jacobi", stop_time)
 
 
 def step_count(stop_time: float, step_size: float) -> int:
@@ -192,8 +213,10 @@ def one_line(exc: BaseException) -> str:
     return f"{type(exc).__name__}" + (f": {message}" if message else "")
 
 
-def _run_ssd(ssd, ssp_path, tmp: Path, n: int, step_size: float, progress) -> dict[str, np.ndarray]:
-    """cosimulate's run of the SSD read from ssp_path, extracted into tmp, for n steps of step_size: its record."""
+def _run_ssd(ssd, ssp_path, tmp: Path, n: int, step_size: float, progress, jacobi: bool = False,
+             stop_time: float = 0.0) -> dict[str, np.ndarray]:
+    """cosimulate's run of the SSD read from ssp_path, extracted into tmp, for n steps of step_size (jacobi:
+    Jacobi steps with time summed to stop_time, _jacobi_steps): its record."""
     ssp_dir = tmp / "ssp"
     try:
         extract(str(ssp_path), unzipdir=ssp_dir)
@@ -214,10 +237,14 @@ def _run_ssd(ssd, ssp_path, tmp: Path, n: int, step_size: float, progress) -> di
                 raise RuntimeError(f"component {element.name} failed to initialise: {exc}") from None
         # the record's columns: each component's Real outputs, then its Boolean ones, in stepping order
         columns = {f"{c.name}.{v}": (c, v) for c in order for v in c.real_out + c.bool_out}
-        values = _steps(order, list(columns), n, step_size, progress)
+        _initialise(order, list(columns) if jacobi else None)
+        if jacobi:
+            times, values = _jacobi_steps(order, list(columns), stop_time, step_size, n, progress)
+        else:
+            times, values = (np.arange(n) + 1) * step_size, _steps(order, list(columns), n, step_size, progress)
         record = {name: values[:, j].astype(bool) if v in c.bool_out else values[:, j]
                   for j, (name, (c, v)) in enumerate(columns.items())}
-        record["time"] = (np.arange(n) + 1) * step_size
+        record["time"] = times
         return record
     finally:
         for comp in components.values():
@@ -237,6 +264,51 @@ def _connect(components: dict, c) -> None:
         raise ValueError(f"{where}: {c.startElement}.{c.startConnector} is neither Real nor Boolean")
     components[c.endElement].variable(c.endConnector, where, "input")
     components[c.endElement].inputs.append((c.endConnector, c.startElement, c.startConnector))
+
+
+def _initialise(order, columns) -> None:
+    """Every component out of Initialization Mode; with columns (a Jacobi master's), each one's inputs
+    first set to its sources' outputs read in Initialization Mode, in stepping order, as OMSimulator
+    does before fmi2ExitInitializationMode."""
+    for comp in order:
+        try:
+            if columns is not None and comp.inputs:
+                sources = {c.name: dict(zip(c.real_out + c.bool_out, c.output_values())) for c in order
+                           if any(src == c.name for _, src, _ in comp.inputs)}
+                comp.fmu.setReal(comp.input_vr, [sources[src][out] for _, src, out in comp.inputs])
+        except FMICallException as exc:
+            raise RuntimeError(f"component {comp.name} failed to initialise: {exc}") from None
+    for comp in order:
+        try:
+            comp.fmu.exitInitializationMode()
+        except FMICallException as exc:
+            raise RuntimeError(f"component {comp.name} failed to initialise: {exc}") from None
+
+
+def _jacobi_steps(order, columns, stop_time: float, h: float, n: int, progress) -> tuple[np.ndarray, np.ndarray]:
+    """Jacobi steps (cosimulate's master "jacobi") from 0 of h seconds, time summed, the last one to stop_time:
+    (the end of each step, the record of the outputs "component.variable" after it, Booleans as 0 or 1)."""
+    where = {name: j for j, name in enumerate(columns)}
+    before = np.empty(len(columns))
+    for comp in order:
+        before[[where[f"{comp.name}.{v}"] for v in comp.real_out + comp.bool_out]] = comp.output_values()
+    sources = {comp.name: [where[f"{src}.{out}"] for _, src, out in comp.inputs] for comp in order}
+    places = {comp.name: [where[f"{comp.name}.{v}"] for v in comp.real_out + comp.bool_out] for comp in order}
+    record, times, t, k = np.empty((n + 1, len(columns))), np.empty(n + 1), 0.0, 0
+    while t < stop_time and k <= n:  # summed, the time falls short of stop_time by picoseconds: one step more
+        end = min(t + h, stop_time)
+        for comp in order:
+            if comp.inputs:
+                comp.fmu.setReal(comp.input_vr, list(before[sources[comp.name]]))
+            try:
+                comp.fmu.doStep(currentCommunicationPoint=t, communicationStepSize=end - t)
+            except FMICallException as exc:
+                raise RuntimeError(f"component {comp.name} failed at t = {t!r} s over {end - t!r} s: {exc}") from None
+            record[k, places[comp.name]] = comp.output_values()
+        before, times[k], t, k = record[k], end, end, k + 1
+        if progress is not None and k % max(1, n // 100) == 0:
+            progress(k / (n + 1))
+    return times[:k], record[:k]
 
 
 def _steps(order, columns, n: int, h: float, progress) -> np.ndarray:

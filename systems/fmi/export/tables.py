@@ -36,7 +36,8 @@ def variables(diagram, fmi: str = "2.0", scalar_parameters: bool = False) -> tup
     for label in system.input_labels:
         table.real(label, 0.0, signal_unit(label), f"input {label}", IN)
     for label in system.output_labels:
-        table.real(label, 0.0, signal_unit(label), f"output {label} (at the sample the last step began)", OUT)
+        table.real(label, 0.0, signal_unit(label), f"output {label} (at the sample the last step began; before the "
+                   "first step, sample 0's)", OUT, calculated=True)
     for index, block in enumerate(diagram.blocks):
         if block.lti is None:
             continue

@@ -20,20 +20,25 @@ CONVENTIONS = {
     "AttitudeEstimator": STEP + "The inputs of sample k are the gyro's mean rate over (t[k], t[k+1]] "
     "(gyr_samples mean; point: the rate at t[k+1]) and the specific force and magnetic field at t[k+1] "
     "(acc_samples point). After the step the outputs are the estimate at sample k, that is at t[k+1]; "
-    "no output depends on an input within the step. A step other than Ts re-discretises the filter "
-    "(logged once, with status OK).",
+    "no output depends on an input within the step. Steps run on the grid of Ts from the start time: a step "
+    "runs the samples it reaches with its inputs held; one that reaches none holds the outputs.",
     "NoOpEstimator": STEP + "doStep does nothing: the outputs keep their start values (a benchmark's baseline).",
     "ImuSensor": STEP + "The inputs of sample k are the true angular rate's mean over (t[k], t[k+1]] and the "
-    "specific force and magnetic field at t[k+1]; after the step the outputs are the measurements of sample k.",
+    "specific force and magnetic field at t[k+1]; after the step the outputs are the measurements of sample k. "
+    "Before the first step (in Initialization Mode and after it) the outputs are the sensor's model of its "
+    "inputs without noise.",
     "MotionProfile": "doStep(t[k], h) with h = t[k+1] - t[k] sets the outputs of sample k: the mean angular "
-    "rate over (t[k], t[k+1]] and the specific force, magnetic field and true orientation at t[k+1]. The "
-    "FMU has no inputs.",
+    "rate over (t[k], t[k+1]] and the specific force, magnetic field and true orientation at t[k+1]. Before "
+    "the first step (in Initialization Mode and after it) they are the motion's at the start time: that "
+    "instant's rate and specific force. The FMU has no inputs.",
 }
 EXPORTED = STEP + ("After the step the outputs are the exported python-control system's outputs at sample k, as "
                    "control.input_output_response computes them (attitude_fmu.export_fmu).")
 
 
 def _start(v) -> str:
+    if v.initial == "calculated":
+        return "calculated (at the start time)"
     if v.type == ENUMERATION:
         return f"{v.items[v.start - 1]} ({v.start})"
     return start_text(v)

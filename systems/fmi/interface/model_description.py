@@ -130,20 +130,24 @@ def model_variables(variables) -> Element:
             typed.set("declaredType", _quantity(v))
         if v.unit is not None:
             typed.set("unit", v.unit)
-        typed.set("start", start_text(v))
+        if v.initial != "calculated":  # FMI 2.0 gives a calculated variable no start
+            typed.set("start", start_text(v))
     return node
 
 
 def model_structure(variables) -> Element:
-    """The outputs, by their 1-based index in ModelVariables; none has an initial unknown (they
-    start exact). No output depends on an input within a step (dependencies=""): the outputs
-    after doStep(t, h) come from the inputs held over it, set before it."""
+    """The outputs, by their 1-based index in ModelVariables. No output depends on an input within
+    a step (dependencies=""): the outputs after doStep(t, h) come from the inputs held over it, set
+    before it. The calculated outputs (those at the start time: Table.real) are the initial
+    unknowns, each depending on every known (inputs and parameters: no dependencies attribute)."""
     structure = Element("ModelStructure")
-    outputs = [k + 1 for k, v in enumerate(variables) if v.causality == OUT]
-    if outputs:
-        node = SubElement(structure, "Outputs")
-        for index in outputs:
-            SubElement(node, "Unknown", index=str(index), dependencies="")
+    for section, chosen, fixed in (("Outputs", lambda v: v.causality == OUT, {"dependencies": ""}),
+                                   ("InitialUnknowns", lambda v: v.initial == "calculated", {})):
+        indices = [k + 1 for k, v in enumerate(variables) if chosen(v)]
+        if indices:
+            node = SubElement(structure, section)
+            for index in indices:
+                SubElement(node, "Unknown", index=str(index), **fixed)
     return structure
 
 
@@ -217,7 +221,7 @@ def model_variables3(variables) -> Element:
             attributes["declaredType"] = v.declared_type
         elif _quantity(v) is not None:
             attributes["declaredType"] = _quantity(v)
-        if v.type != STRING and v.causality != "independent":
+        if v.type != STRING and v.causality != "independent" and v.initial != "calculated":
             attributes["start"] = start_text(v)
         if v.unit is not None:
             attributes["unit"] = v.unit
@@ -233,7 +237,7 @@ def model_description3(name: str, description: str, instantiation_token: str, va
                        step: float | None = None) -> Element:
     """The modelDescription.xml of an FMI 3.0 co-simulation FMU in C whose binary is named name,
     with the capabilities of fmu_src/fmi3 and the metadata of the project's version. No output
-    depends on an input within a step (model_structure)."""
+    depends on an input within a step; the calculated outputs are initial unknowns (model_structure)."""
     root = Element("fmiModelDescription", {
         "fmiVersion": "3.0", "modelName": name, "instantiationToken": instantiation_token,
         "description": description, "generationTool": f"attitude-fmu {version}",
@@ -253,4 +257,7 @@ def model_description3(name: str, description: str, instantiation_token: str, va
     for v in variables:
         if v.causality == OUT:
             SubElement(structure, "Output", valueReference=str(v.value_reference), dependencies="")
+    for v in variables:
+        if v.initial == "calculated":
+            SubElement(structure, "InitialUnknown", valueReference=str(v.value_reference))
     return root

@@ -18,9 +18,9 @@ def imu_sensor() -> tuple[Variable, ...]:
     t.vector("omega", (0.0, 0.0, 0.0), "rad/s", "true angular rate {c}, mean over the step", IN)
     t.vector("f", (0.0, 0.0, 9.81), "m/s2", "true specific force {c}", IN)
     t.vector("m", EARTH_FIELD_UT, "uT", "true magnetic field {c}", IN)
-    t.vector("gyr", (0.0, 0.0, 0.0), "rad/s", "measured angular rate {c}", OUT)
-    t.vector("acc", (0.0, 0.0, 9.81), "m/s2", "measured specific force {c}", OUT)
-    t.vector("mag", EARTH_FIELD_UT, "uT", "measured magnetic field {c}", OUT)
+    t.vector("gyr", (0.0, 0.0, 0.0), "rad/s", "measured angular rate {c}", OUT, calculated=True)
+    t.vector("acc", (0.0, 0.0, 9.81), "m/s2", "measured specific force {c}", OUT, calculated=True)
+    t.vector("mag", EARTH_FIELD_UT, "uT", "measured magnetic field {c}", OUT, calculated=True)
     t.real("delta_n", 0.0, "rad/s/sqrt(Hz)", "gyro white-noise density, one-sided", PAR)
     t.vector("gyr_offset", (0.0, 0.0, 0.0), "rad/s", "constant gyro offset {c}", PAR)
     for row in "xyz":
@@ -43,10 +43,11 @@ def motion_profile() -> tuple[Variable, ...]:
     """MotionProfile's interface: the truth it outputs, the profile, and every profile's parameters
     as <profile>_<parameter> at the profile's defaults."""
     t = Table()
-    t.vector("omega", (0.0, 0.0, 0.0), "rad/s", "true angular rate {c}, mean over the step", OUT)
-    t.vector("f", (0.0, 0.0, 9.81), "m/s2", "true specific force {c}, sensor coordinates", OUT)
-    t.vector("m", EARTH_FIELD_UT, "uT", "true magnetic field {c}, sensor coordinates", OUT)
-    t.vector("qt", (1.0, 0.0, 0.0, 0.0), "1", "true orientation quaternion {c}, sensor -> earth (ENU)", OUT, "wxyz")
+    t.vector("omega", (0.0, 0.0, 0.0), "rad/s", "true angular rate {c}, mean over the step", OUT, calculated=True)
+    t.vector("f", (0.0, 0.0, 9.81), "m/s2", "true specific force {c}, sensor coordinates", OUT, calculated=True)
+    t.vector("m", EARTH_FIELD_UT, "uT", "true magnetic field {c}, sensor coordinates", OUT, calculated=True)
+    t.vector("qt", (1.0, 0.0, 0.0, 0.0), "1", "true orientation quaternion {c}, sensor -> earth (ENU)", OUT, "wxyz",
+             calculated=True)
     t.choice("profile", PROFILES, "human", "motion profile")
     t.parameter("seed", 0, "seed of random profiles (systems.simulation.noise)", INTEGER)
     t.real("g", 9.81, "m/s2", "magnitude of gravity", PAR)

@@ -141,15 +141,18 @@ class Table(list):
                              sum(v.size for v in self), unit, initial, tuple(items), tuple(dimensions)))
         return self[-1:]
 
-    def real(self, name, start, unit, description, causality) -> list[Variable]:
-        """A Real input, output or (fixed) parameter; outputs start exact, held until a step sets them."""
+    def real(self, name, start, unit, description, causality, calculated=False) -> list[Variable]:
+        """A Real input, output or (fixed) parameter. Outputs start exact at start, held until a step sets
+        them; calculated: the FMU computes them at the start time in Initialization Mode (initial
+        "calculated": the model description gives no start, the FMU's own value before then is start)."""
+        initial = ("calculated" if calculated else "exact") if causality == OUT else None
         return self.add(name, REAL, causality, "fixed" if causality == PAR else "continuous", float(start),
-                        description, unit, "exact" if causality == OUT else None)
+                        description, unit, initial)
 
-    def vector(self, prefix, start, unit, description, causality, components="xyz") -> list[Variable]:
+    def vector(self, prefix, start, unit, description, causality, components="xyz", calculated=False) -> list[Variable]:
         """prefix_<c> for each component c; description may use {c}."""
         return [v for c, value in zip(components, start)
-                for v in self.real(f"{prefix}_{c}", value, unit, description.format(c=c), causality)]
+                for v in self.real(f"{prefix}_{c}", value, unit, description.format(c=c), causality, calculated)]
 
     def parameter(self, name, start, description, type_=INTEGER) -> list[Variable]:
         """A fixed Integer or Boolean parameter."""

@@ -74,7 +74,8 @@ void lever_force(const double r[3], const double w0[3], const double w1[3], cons
 void rotation_vector(const double quat[4], double r[3]);
 /* the profile of that name: its number, or -1 */
 int closed_form_profile(const char *name);
-/* the interval (t - h, t]: gyr (rad/s), specific force f (m/s^2, sensor coordinates), quat (at t) */
+/* the interval (t - h, t]: gyr (rad/s), specific force f (m/s^2, sensor coordinates), quat (at t); h = 0: the
+ * instant t, its rate and specific force (their limit over (t, t + h], within about 1e-10) */
 void closed_form_at(const ClosedForm *motion, double t, double h, double gyr[3], double f[3], double quat[4]);
 /* the intervals ending at the n times t, each h long: gyr, f (n rows of 3), quat (n rows of 4) */
 void closed_form_run(const ClosedForm *motion, const double *t, size_t n, double h, double *gyr, double *f,
