@@ -223,6 +223,18 @@ static void load_inner(void) {
     FMI2_CALLS(LOAD_CALL)
 #undef LOAD_CALL
 #undef LOAD
+    /* pythonfmu's library releases its static shared_ptr to its Python state twice when the
+     * process exits with it loaded (as RTLD_NODELETE keeps it): exit() first runs the
+     * shared_ptr's C++ destructor (registered with __cxa_atexit when the library loaded), which
+     * frees the control block, then _dl_fini runs the library's __attribute__((destructor)),
+     * finalizePythonInterpreter, whose `pyState = nullptr` decrements the use count inside that
+     * freed block: the heap's free list is corrupted, and the next free() that walks it aborts
+     * ("free(): corrupted unsorted chunks", in whichever library's destructor frees next: scipy's
+     * libgfortran). Handlers registered later run earlier: finalizePythonInterpreter, registered
+     * here, releases the state while it is alive, and both of pythonfmu's own releases then find
+     * it empty. (A host that unloads this library runs the handler then; pythonfmu's stays.) */
+    void (*finalize)(void);
+    if ((*(void **)&finalize = dlsym(lib, "finalizePythonInterpreter"))) atexit(finalize);
     load_error = NULL;
 }
 

@@ -702,6 +702,50 @@ def test_fmu_runs_in_an_importer_without_python(fmu_dir, tmp_path):
     assert np.abs(np.array(proc.stdout.split(), dtype=float) - np.r_[online.quat, online.up]).max() < 1e-9
 
 
+EXIT_RUNS = 20  # runs of each pythonfmu FMU in test_pythonfmu_fmus_let_an_importer_without_python_exit_normally
+HOST_INPUTS = {  # each FMU's inputs for those runs (the host sets them before every step)
+    "AttitudeEstimator": dict(zip(INPUTS, (0.3, -0.1, 0.05, 1.0, 2.0, 9.5))),
+    "ImuSensor": {"omega_x": 0.1, "omega_y": -0.2, "f_z": 9.81, "m_x": 20.0, "m_z": -40.0},
+    "MotionProfile": {},
+}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", FMU_NAMES)
+def test_pythonfmu_fmus_let_an_importer_without_python_exit_normally(fmu_dir, tmp_path, name):
+    """A C importer with no Python (tests/fmi_host.c) runs the FMU, frees the instance and
+    returns from main, as most tools end: exit() runs the atexit handlers and then the
+    libraries' destructors. It ends with status 0, EXIT_RUNS runs in EXIT_RUNS. Without the
+    guard's atexit handler (fmi2_guard.c, load_inner) pythonfmu's library released its Python
+    state twice there: its static shared_ptr's destructor freed the control block, then its
+    own __attribute__((destructor)) decremented the count inside the freed block, and the next
+    free() aborted ("free(): corrupted unsorted chunks": scipy's libgfortran's, every run).
+    Built without the sanitizers (tests/native.py): the address sanitizer's allocator holds
+    freed blocks back, so the corruption would go unseen."""
+    from fmpy import extract, read_model_description
+
+    if not any(python_environment().splitlines()[:2]):
+        pytest.skip("this Python has no shared libpython to start in another process")
+    folder = c_build.build(["fmi_host", "fmi2_guard"])
+    host, guard = folder / "tests" / "fmi_host", folder / "built" / "fmi2_guard.so"
+    unzipped = Path(extract(str(fmu_dir / f"{name}.fmu"), unzipdir=str(tmp_path / name)))
+    binary = unzipped / "binaries" / "linux64" / f"{name}.so"
+    shutil.copyfile(guard, binary)  # this clone's guard as the FMU's binary
+    md = read_model_description(str(unzipped / "modelDescription.xml"))
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    outputs = [v.name for v in md.modelVariables if v.causality == "output" and v.type == "Real"]
+    inputs = HOST_INPUTS[name]
+    args = [str(host), str(binary), md.guid, (unzipped / "resources").as_uri(), "20", "0.01",
+            *(str(vr[n]) for n in inputs), "--", *(repr(v) for v in inputs.values()), "--",
+            *(str(vr[n]) for n in outputs)]
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME", "VIRTUAL_ENV")}
+    for run in range(EXIT_RUNS):
+        proc = subprocess.run(args, capture_output=True, text=True, env=env, timeout=600)
+        assert proc.returncode == 0, f"run {run + 1} of {EXIT_RUNS}: status {proc.returncode}\n{proc.stderr[-2000:]}"
+        values = np.array(proc.stdout.split(), dtype=float)
+        assert values.shape == (len(outputs),) and np.isfinite(values).all(), proc.stdout
+
+
 def test_verify_cli_json_contract_and_exit_status(fmu_dir, monkeypatch, capsys):
     from attitude_fmu.systems.cli.commands import main
     from attitude_fmu.systems.fmi import verify as verify_module
