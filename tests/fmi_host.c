@@ -5,7 +5,8 @@
  * outputs VR_OUT, one per line. With VR_STRING (a String variable) it also makes the calls
  * FMI 2.0 does not allow, fmi2SetReal on VR_STRING before initialisation and fmi2DoStep
  * before it and after fmi2Terminate, and prints "misuse S1 S2 S3", their statuses, on
- * standard error. It then returns from main, as a tool does: exit() runs the atexit
+ * standard error. With FMI_HOST_RELOAD set in its environment it unloads the FMU after the run and
+ * loads and runs it once more. It then returns from main, as a tool does: exit() runs the atexit
  * handlers and the libraries' destructors, pythonfmu's among them (fmi2_guard.c makes those
  * safe), and the process's status is the run's. */
 #include <dlfcn.h>
@@ -43,13 +44,8 @@ typedef int (*DoStep)(Component, double, double, int);
 typedef void (*Free)(Component);
 #define CALL(type, name) type name = (type)dlsym(lib, #name)
 
-int main(int argc, char **argv) {
-    if (argc < 6) return 2;
-    void *lib = dlopen(argv[1], RTLD_NOW | RTLD_LOCAL);
-    if (!lib) {
-        fprintf(stderr, "dlopen: %s\n", dlerror());
-        return 3;
-    }
+/* one run of the FMU in lib, as the usage says: the process's status */
+static int run(void *lib, int argc, char **argv) {
     CALL(Instantiate, fmi2Instantiate);
     CALL(Setup, fmi2SetupExperiment);
     CALL(Mode, fmi2EnterInitializationMode);
@@ -96,4 +92,21 @@ int main(int argc, char **argv) {
     }
     fmi2FreeInstance(c);
     return status ? 5 : 0;
+}
+
+int main(int argc, char **argv) {
+    if (argc < 6) return 2;
+    /* FMI_HOST_RELOAD set: the FMU unloaded after its run and loaded and run again, as a tool that runs two
+     * simulations in one process does */
+    for (int load = 0; load < (getenv("FMI_HOST_RELOAD") ? 2 : 1); load++) {
+        void *lib = dlopen(argv[1], RTLD_NOW | RTLD_LOCAL);
+        if (!lib) {
+            fprintf(stderr, "dlopen: %s\n", dlerror());
+            return 3;
+        }
+        int status = run(lib, argc, argv);
+        dlclose(lib);
+        if (status) return status;
+    }
+    return 0;
 }

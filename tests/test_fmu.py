@@ -721,7 +721,8 @@ def test_pythonfmu_fmus_let_an_importer_without_python_exit_normally(fmu_dir, tm
     own __attribute__((destructor)) decremented the count inside the freed block, and the next
     free() aborted ("free(): corrupted unsorted chunks": scipy's libgfortran's, every run).
     Built without the sanitizers (tests/native.py): the address sanitizer's allocator holds
-    freed blocks back, so the corruption would go unseen."""
+    freed blocks back, so the corruption would go unseen. A host that unloads the FMU and loads it
+    again runs it twice alike (the handler waits for the exit)."""
     from fmpy import extract, read_model_description
 
     if not any(python_environment().splitlines()[:2]):
@@ -744,6 +745,11 @@ def test_pythonfmu_fmus_let_an_importer_without_python_exit_normally(fmu_dir, tm
         assert proc.returncode == 0, f"run {run + 1} of {EXIT_RUNS}: status {proc.returncode}\n{proc.stderr[-2000:]}"
         values = np.array(proc.stdout.split(), dtype=float)
         assert values.shape == (len(outputs),) and np.isfinite(values).all(), proc.stdout
+    # a host that unloads the FMU and loads it again in the same process (two simulations): the guard stays
+    # loaded, so its handler waits for the exit and the second run finds its Python alive
+    proc = subprocess.run(args, capture_output=True, text=True, env={**env, "FMI_HOST_RELOAD": "1"}, timeout=600)
+    assert proc.returncode == 0, f"reloaded: status {proc.returncode}\n{proc.stderr[-2000:]}"
+    np.testing.assert_array_equal(*np.array(proc.stdout.split(), dtype=float).reshape(2, len(outputs)))
 
 
 def test_verify_cli_json_contract_and_exit_status(fmu_dir, monkeypatch, capsys):
