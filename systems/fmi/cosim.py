@@ -237,7 +237,7 @@ def _run_ssd(ssd, ssp_path, tmp: Path, n: int, step_size: float, progress, jacob
                 raise RuntimeError(f"component {element.name} failed to initialise: {exc}") from None
         # the record's columns: each component's Real outputs, then its Boolean ones, in stepping order
         columns = {f"{c.name}.{v}": (c, v) for c in order for v in c.real_out + c.bool_out}
-        _initialise(order, list(columns) if jacobi else None)
+        _initialise(order, jacobi)
         if jacobi:
             times, values = _jacobi_steps(order, list(columns), stop_time, step_size, n, progress)
         else:
@@ -266,23 +266,22 @@ def _connect(components: dict, c) -> None:
     components[c.endElement].inputs.append((c.endConnector, c.startElement, c.startConnector))
 
 
-def _initialise(order, columns) -> None:
-    """Every component out of Initialization Mode; with columns (a Jacobi master's), each one's inputs
-    first set to its sources' outputs read in Initialization Mode, in stepping order, as OMSimulator
-    does before fmi2ExitInitializationMode."""
-    for comp in order:
-        try:
-            if columns is not None and comp.inputs:
-                sources = {c.name: dict(zip(c.real_out + c.bool_out, c.output_values())) for c in order
-                           if any(src == c.name for _, src, _ in comp.inputs)}
-                comp.fmu.setReal(comp.input_vr, [sources[src][out] for _, src, out in comp.inputs])
-        except FMICallException as exc:
-            raise RuntimeError(f"component {comp.name} failed to initialise: {exc}") from None
-    for comp in order:
-        try:
-            comp.fmu.exitInitializationMode()
-        except FMICallException as exc:
-            raise RuntimeError(f"component {comp.name} failed to initialise: {exc}") from None
+def _initialise(order, jacobi: bool) -> None:
+    """Every component out of Initialization Mode; for a Jacobi master, each one's inputs first set to its
+    sources' outputs read in Initialization Mode, in stepping order, as OMSimulator does before
+    fmi2ExitInitializationMode."""
+    by_name = {c.name: c for c in order}
+    for stage in ("inputs", "exit") if jacobi else ("exit",):
+        for comp in order:
+            try:
+                if stage == "exit":
+                    comp.fmu.exitInitializationMode()
+                elif comp.inputs:
+                    values = {src: dict(zip(by_name[src].real_out + by_name[src].bool_out,
+                                            by_name[src].output_values())) for _, src, _ in comp.inputs}
+                    comp.fmu.setReal(comp.input_vr, [values[src][out] for _, src, out in comp.inputs])
+            except FMICallException as exc:
+                raise RuntimeError(f"component {comp.name} failed to initialise: {exc}") from None
 
 
 def _jacobi_steps(order, columns, stop_time: float, h: float, n: int, progress) -> tuple[np.ndarray, np.ndarray]:
@@ -347,8 +346,7 @@ def _python_steps(order, where: dict, record: np.ndarray, h: float, progress) ->
                 comp.fmu.doStep(currentCommunicationPoint=t, communicationStepSize=h)
             except FMICallException as exc:
                 raise RuntimeError(f"component {comp.name} failed at t = {t:g} s: {exc}") from None
-            values = comp.fmu.getReal(comp.real_out_vr) + (comp.fmu.getBoolean(comp.bool_out_vr) if comp.bool_out_vr else [])
-            for name, value in zip(comp.real_out + comp.bool_out, values):
+            for name, value in zip(comp.real_out + comp.bool_out, comp.output_values()):
                 record[k, where[f"{comp.name}.{name}"]] = value
         if progress is not None and k % max(1, n // 100) == 0:
             progress(k / n)
