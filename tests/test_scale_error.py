@@ -129,10 +129,65 @@ def test_a_lower_candidate_is_taken_only_where_its_blocks_show_it(z, taken):
                 out[j * block:(j + 1) * block, 2] = G + math.sqrt(D**2 + difference)
         return out
 
-    found, errors = scale_error.choose(gyr, acc, FS, run)
+    found, errors = scale_error.choose({c: scale_error.prediction_errors(gyr, acc, run(c), FS, block) for c in SCALE_ERRORS})
     assert errors[DEFAULT] == pytest.approx(D**2, rel=1e-12)
     assert errors[0.0] - errors[DEFAULT] == pytest.approx(np.mean(differences), rel=1e-6, abs=1e-15)
     assert found == (0.0 if taken else DEFAULT)
+
+
+@pytest.mark.parametrize("windowed", [True, False])
+def test_one_pass_scores_each_candidate_as_its_own_run_does(windowed):
+    """scale_error.block_errors (one pass over each window for every candidate) gives, bit for bit,
+    the block errors of each candidate run alone through the causal pipeline (warm-up with the
+    default, then the candidate from its state; or from initial_gravity over every row) and
+    scored by prediction_errors from the horizon before its first row scored."""
+    from copy import copy
+
+    from attitude_fmu.blocks.pipeline.causal import State, at, configure, run
+
+    rec = _recording("consumer", 1)
+    gyr, acc = np.ascontiguousarray(rec.gyr[:9000]), np.ascontiguousarray(rec.acc[:9000])
+    windows = [(0, 1000, 4000), (4000, 5500, 9000)] if windowed else None
+    start = None if windowed else np.array([0.3, -0.2, 9.7])
+    block, m = round(scale_error.BLOCK_S * FS), HORIZON
+
+    def alone(params):
+        pipeline = configure("wiener", params, gyro_offset=False)
+        return pipeline, at(pipeline, 1.0 / FS)
+
+    expected = {c: [] for c in SCALE_ERRORS}
+    for first, scored, end in windows or [(0, 0, len(gyr))]:
+        state, gravity = State(), np.empty((end - first, 3))
+        if scored > first:
+            gravity[:scored - first] = run(*alone({}), state, gyr[first:scored], acc[first:scored]).gravity
+        for c in SCALE_ERRORS:
+            gravity[scored - first:] = run(*alone({"scale_error": c}), copy(state), gyr[scored:end], acc[scored:end],
+                                           initial_gravity=start).gravity
+            a = max(scored - m, first)
+            expected[c].append(scale_error.prediction_errors(gyr[a:end], acc[a:end], gravity[a - first:], FS, block))
+    got = scale_error.block_errors(alone({})[1].core, [alone({"scale_error": c})[1].core for c in SCALE_ERRORS],
+                                   gyr, acc, FS, windows, start, workers=2)
+    assert got.shape == (len(SCALE_ERRORS), sum(len(e) for e in expected[DEFAULT]))
+    for row, c in zip(got, SCALE_ERRORS):
+        assert np.array_equal(row, np.concatenate(expected[c]))
+
+
+def test_one_pass_refuses_what_it_cannot_score():
+    """The kernel scores the Wiener filter with local densities at one sample time alone."""
+    from attitude_fmu.blocks.pipeline.causal import at, configure
+
+    def step(method="wiener", params=None, Ts=0.01):
+        return at(configure(method, params, gyro_offset=False), Ts).core
+
+    rows = np.zeros((100, 3))
+    with pytest.raises(ValueError, match="local densities alone"):
+        _core.scale_error_errors(step(), [step("wiener", {"stationary": 1})], rows, rows, 10, None, 5, 10)
+    with pytest.raises(ValueError, match="share the sample time"):
+        _core.scale_error_errors(step(), [step(Ts=0.02)], rows, rows, 10, None, 5, 10)
+    with pytest.raises(ValueError, match="1 to 8 candidates"):
+        _core.scale_error_errors(step(), [], rows, rows, 10, None, 5, 10)
+    with pytest.raises(ValueError, match="warm-up is longer"):
+        _core.scale_error_errors(step(), [step()], rows, rows, 101, None, 5, 10)
 
 
 @pytest.mark.parametrize("theta", [0.0, 0.1, 1.0])

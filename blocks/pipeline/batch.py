@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from copy import copy
 from dataclasses import dataclass
 
 import numpy as np
@@ -192,7 +191,7 @@ def _chosen_scale_error(pipeline: Pipeline, step: Step, gyr, acc, initial_gravit
     its offset by a forward pass), over the windows of scale_error.subset, one after another
     (each from the start at rest on its first rows, its warm-up with the method's default
     scale_error, each candidate on from there), or over every row from initial_gravity where
-    that is None; candidates on up to threads threads at once (None: a thread for each CPU the
+    that is None; the windows on up to threads threads at once (None: a thread for each CPU the
     process may run on)."""
     fs = 1.0 / step.Ts
     gyr = interval_means(gyr) if pipeline.point_gyr else gyr
@@ -201,35 +200,23 @@ def _chosen_scale_error(pipeline: Pipeline, step: Step, gyr, acc, initial_gravit
     windows = None
     if found is not None:
         rows, windows = found
-        gyr, acc, initial_gravity = gyr[rows], acc[rows], None
-    spans = windows or [(0, 0, len(gyr))]
+        gyr, acc = gyr[rows], acc[rows]
     variance = np.zeros_like(gyr)
     if pipeline.offset_params is not None:
         offset, variance = offset_estimate(gyr, acc, fs, pipeline.offset_params)
         gyr = gyr - offset
     own = dict(pipeline.params)
 
-    def alone(params) -> tuple[Pipeline, Step]:
-        method = configure(pipeline.method, params, gyro_offset=False)
-        return method, at(method, step.Ts)
+    def alone(params) -> _core.Step:
+        return at(configure(pipeline.method, params, gyro_offset=False), step.Ts).core
 
-    default, gravity, states = alone(own), np.empty_like(gyr), []  # the warm-ups' estimates; each window's state after
-    for first, scored, _ in spans:
-        states.append(State())
-        if scored > first:
-            gravity[first:scored] = run(*default, states[-1], gyr[first:scored], acc[first:scored], threads=1).gravity
-
-    def candidate(value: float) -> np.ndarray:
-        out, method = gravity.copy(), alone({**own, "scale_error": value})
-        for (_, scored, end), state in zip(spans, states):
-            out[scored:end] = run(*method, copy(state), gyr[scored:end], acc[scored:end],
-                                  initial_gravity=initial_gravity, threads=1).gravity
-        return out
-
-    found = scale_error.choose(gyr, acc, fs, candidate, windows, _core.cpus() if threads is None else threads)
+    per_block = scale_error.block_errors(alone(own), [alone({**own, "scale_error": c}) for c in scale_error.SCALE_ERRORS],
+                                         gyr, acc, fs, windows, initial_gravity,
+                                         _core.cpus() if threads is None else threads)
+    found = None if per_block is None else scale_error.choose(dict(zip(scale_error.SCALE_ERRORS, per_block)))
     if found is None:
         return None
-    counted = np.concatenate([np.arange(scored, end) for _, scored, end in spans])
+    counted = np.concatenate([np.arange(scored, end) for _, scored, end in windows or [(0, 0, len(gyr))]])
     return (found[0], float(np.mean(np.einsum("ij,ij->i", gyr[counted], gyr[counted]))),
             float(np.mean(variance[counted])))
 

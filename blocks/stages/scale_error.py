@@ -49,6 +49,7 @@ the default, 12000 of each candidate).
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
@@ -100,33 +101,44 @@ def subset(n: int, fs: float) -> tuple[np.ndarray, list[tuple[int, int, int]]] |
             [(i * length, i * length + warm_up, (i + 1) * length) for i in range(WINDOWS)])
 
 
-def choose(gyr, acc, fs: float, run, windows=None, workers: int = 1) -> tuple[float, dict[float, float]] | None:
-    """(the chosen scale error, {candidate: prediction error}) for gyr (N×3 rad/s, freed of its
-    offset) and acc (N×3 m/s²) at fs Hz; run(scale_error) gives the method's gravity (N×3,
-    m/s²) with that value. windows: (first, first scored, end) triples as subset gives them,
-    scored over their rows scored (the gyro turned from the horizon before); None: over every
-    row from the horizon on. The rows scored are cut into blocks of BLOCK_S; a candidate below
-    the default is taken only where its error is below the default's by more than SIGNIFICANCE
-    standard errors of the blocks' paired differences (of those, the least error), else the
-    default. workers: candidates run and scored at once on threads (the C core runs without
-    Python's lock), the result the same. None where the recording is no longer than the
-    horizon."""
-    m = max(1, round(PREDICTION_HORIZON_S * fs))
-    if len(gyr) <= m:
-        return None
-    spans = [(0, len(gyr))] if windows is None else [(scored - m, end) for _, scored, end in windows]
-    block = max(1, round(BLOCK_S * fs))
+def block_errors(warm: _core.Step, candidates: Sequence[_core.Step], gyr, acc, fs: float, windows=None,
+                 initial_gravity=None, workers: int = 1) -> np.ndarray | None:
+    """The candidates' prediction errors (m²/s⁴) over blocks of BLOCK_S: an array of a row per
+    candidate (its Step, the Wiener filter with local densities alone, as SCALE_ERRORS's values
+    make it) over gyr (N×3 rad/s, freed of its offset) and acc (N×3 m/s²) at fs Hz, in one pass
+    over each window (blocks/core/stages/scale_error.h: the orientation integrated and the local
+    densities computed once for all). windows: (first, first scored, end) triples as subset gives
+    them, each started at rest on its first row (start_gravity) and run with warm (the method's
+    default) up to its first row scored, each candidate on from there; the rows scored, from the
+    horizon before them, predicted. None: every candidate over every row from initial_gravity
+    (m/s²; None: start_gravity), scored from the horizon on. workers: windows at once on threads
+    (the C core runs without Python's lock), the result the same. None where no row is scored."""
+    m, block = max(1, round(PREDICTION_HORIZON_S * fs)), max(1, round(BLOCK_S * fs))
+    gyr, acc = _rows(gyr, acc)
+    spans = [(0, 0, len(gyr))] if windows is None else windows
+    given = None if initial_gravity is None or windows is not None else np.asarray(initial_gravity, dtype=float)
 
-    def block_errors(candidate: float) -> np.ndarray:
-        gravity = run(candidate)
-        return np.concatenate([prediction_errors(gyr[a:b], acc[a:b], gravity[a:b], fs, block) for a, b in spans])
+    def window(span) -> np.ndarray:
+        first, scored, end = span
+        return _core.scale_error_errors(warm, list(candidates), gyr[first:end], acc[first:end], scored - first, given,
+                                        m, block)
 
-    if workers > 1:
-        with ThreadPoolExecutor(max_workers=min(workers, len(SCALE_ERRORS))) as pool:
-            per_block = dict(zip(SCALE_ERRORS, pool.map(block_errors, SCALE_ERRORS)))
+    if workers > 1 and len(spans) > 1:
+        with ThreadPoolExecutor(max_workers=min(workers, len(spans))) as pool:
+            per_window = list(pool.map(window, spans))
     else:
-        per_block = {c: block_errors(c) for c in SCALE_ERRORS}
-    errors = {c: float(np.mean(e)) for c, e in per_block.items()}
+        per_window = [window(span) for span in spans]
+    errors = np.concatenate(per_window, axis=1)
+    return errors if errors.shape[1] else None
+
+
+def choose(per_block: Mapping[float, np.ndarray]) -> tuple[float, dict[float, float]] | None:
+    """(the chosen scale error, {candidate: prediction error}) from each of SCALE_ERRORS's
+    prediction errors over the same blocks (per_block: candidate → array, m²/s⁴, as block_errors
+    gives them). A candidate below the default is taken only where its error is below the
+    default's by more than SIGNIFICANCE standard errors of the blocks' paired differences (of
+    those, the least error), else the default. None where no error is finite."""
+    errors = {c: float(np.mean(per_block[c])) for c in SCALE_ERRORS}
     default = SCALE_ERRORS[-1]
     if not all(math.isfinite(e) for e in errors.values()):
         return (default, errors) if math.isfinite(errors[default]) else None

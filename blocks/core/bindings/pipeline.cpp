@@ -31,6 +31,7 @@ extern "C" {
 #include "pipeline/offline.h"
 #include "pipeline/online.h"
 #include "quaternion.h"
+#include "stages/scale_error.h"
 }
 
 #include "threads.h"
@@ -515,6 +516,50 @@ void bind_pipeline(nb::module_ &m)
         "step"_a, "gyr"_a, "acc"_a, "initial_gravity"_a.none(), "gravity"_a.noconvert(), "quat"_a.noconvert(),
         "The offline smoother of the step's method over gyr, acc (N x 3): gravity (N x 3) and quat (N x 4) "
         "written; it starts at rest on initial_gravity, None: start_gravity of the first sample.");
+
+    m.def(
+        "scale_error_errors",
+        [](const AfStep &warm, const std::vector<AfStep> &candidates, Rows3 gyr, Rows3 acc, size_t warm_up,
+           std::optional<Vec> initial_gravity, size_t horizon, size_t block) {
+            size_t n = gyr.shape(0), count = candidates.size();
+            check_rows(n, acc.shape(0), "acc");
+            if (count < 1 || count > PREDICTION_MAX_COUNT)
+                throw nb::value_error(("1 to " + std::to_string(PREDICTION_MAX_COUNT) + " candidates, got " +
+                                       std::to_string(count)).c_str());
+            const WienerLocalCoef &w = warm.stepper.coef.wiener_local;
+            auto coef_of = [&w](const AfStep &step) {
+                const WienerLocalCoef &c = step.stepper.coef.wiener_local;
+                if (step.stepper.kernel != KERNEL_WIENER_LOCAL)
+                    throw nb::value_error("scale_error_errors scores the Wiener filter with local densities alone");
+                if (c.Ts != w.Ts || c.a_avg != w.a_avg || c.leak_v != w.leak_v)
+                    throw nb::value_error("the candidates must share the sample time, tau_noise and tau_v");
+                return c;
+            };
+            coef_of(warm);
+            std::vector<WienerLocalCoef> coefs;
+            for (const AfStep &step : candidates) coefs.push_back(coef_of(step));
+            if (warm_up > n) throw nb::value_error("the warm-up is longer than the window");
+            if (horizon < 1 || block < 1) throw nb::value_error("horizon and block must be 1 sample or more");
+            size_t first = warm_up >= horizon ? warm_up - horizon : 0;
+            size_t per = n - first > horizon ? (n - first - horizon + block - 1) / block : 0;
+            double start[3];
+            if (initial_gravity)
+                std::memcpy(start, initial_gravity->data(), sizeof start);
+            else if (n > 0)
+                start_gravity(gyr.data(), acc.data(), w.Ts, start);
+            std::vector<double> gravity(3 * n * count), work(3 * horizon * count), means(count * per);
+            if (per > 0) {
+                nb::gil_scoped_release released;
+                scale_error_errors(&w, coefs.data(), count, n, warm_up, gyr.data(), acc.data(), start, horizon, block,
+                                   gravity.data(), work.data(), means.data());
+            }
+            return array_of(means.data(), {count, per});
+        },
+        "warm"_a, "candidates"_a, "gyr"_a, "acc"_a, "warm_up"_a, "initial_gravity"_a.none(), "horizon"_a, "block"_a,
+        "The candidates' (Steps of the Wiener filter with local densities alone) block means of the prediction "
+        "error (m^2/s^4) over a window of gyr (rad/s) and acc (m/s^2), N x 3: each starts at rest on "
+        "initial_gravity (None: start_gravity of the first sample), runs warm_up rows with warm, then on with "
+        "its own (blocks/core/stages/scale_error.h); an array of one row per candidate.");
 
     // ---- the online estimator
     nb::class_<AfOnline> online(m, "Online", "The causal pipeline one sample at a time.");

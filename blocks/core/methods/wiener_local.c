@@ -88,24 +88,26 @@ void butterworth_zoh(double wt, double Ad[4], double Bd[2])
     Bd[1] = Ad[1];
 }
 
-/* The samples of a block (at most WIENER_LOCAL_BLOCK) in three passes, each with a short chain from
- * sample to sample: the local densities and the break frequencies, the filter, the levelled
- * orientation. */
-static void block(WienerLocalState *restrict state, const WienerLocalCoef *restrict coef, size_t n,
-                  const double *restrict gyr, const double *restrict acc, const double *restrict imposed,
-                  double *restrict gravity, double *restrict quat, double *restrict used)
+/* The break frequency (eq. 25, rad/s) at the running densities W2 = <|w|^2> and V2 = <|v|^2>/3. */
+static inline double break_frequency(const WienerLocalCoef *coef, double W2, double V2)
 {
-    const double Ts = coef->Ts, g = coef->g, dn2 = coef->dn2, k_w = coef->k_w, inv_J = coef->inv_J;
-    const double dv2_min = coef->dv2_min, a_avg = coef->a_avg, leak = coef->leak_v;
-    Quat dq[WIENER_LOCAL_BLOCK];
-    double omega[WIENER_LOCAL_BLOCK];
-    /* the local densities: the accelerometer band-passed into the slosh velocity v (f its low-pass), the rows
-     * earth-fixed, turned into each sample's frame by the inverse of its rotation */
+    double slosh = coef->inv_J * V2;
+    return sqrt(coef->g * sqrt((coef->dn2 + coef->k_w * W2) / (coef->dv2_min > slosh ? coef->dv2_min : slosh)));
+}
+
+/* The first pass over a block of n samples: each sample's rotation dq and the running densities after
+ * it (W2, V2). The accelerometer is band-passed into the slosh velocity v (f its low-pass), the rows
+ * earth-fixed, turned into each sample's frame by the inverse of its rotation. */
+static void densities(WienerLocalState *restrict state, const WienerLocalCoef *restrict coef, size_t n,
+                      const double *restrict gyr, const double *restrict acc, Quat *restrict dq,
+                      double *restrict W2s, double *restrict V2s)
+{
+    const double Ts = coef->Ts, a_avg = coef->a_avg, leak = coef->leak_v;
     Vec3 v = state->v, f = state->f;
     double W2 = state->w2, V2 = state->v2;
     for (size_t k = 0; k < n; k++) {
         const double *w = gyr + 3 * k, *y = acc + 3 * k;
-        double w2, v2, slosh;
+        double w2, v2;
         dq[k] = rotvec_quat(w[0] * Ts, w[1] * Ts, w[2] * Ts);
         v = quat_rotate(quat_conjugate(dq[k]), v);
         f = quat_rotate(quat_conjugate(dq[k]), f);
@@ -119,62 +121,81 @@ static void block(WienerLocalState *restrict state, const WienerLocalCoef *restr
         w2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
         W2 += a_avg * (w2 - W2);
         V2 += a_avg * (v2 * (1.0 / 3.0) - V2);
-        slosh = inv_J * V2;
-        omega[k] = imposed == NULL ? sqrt(g * sqrt((dn2 + k_w * W2) / (dv2_min > slosh ? dv2_min : slosh))) /* eq. 25 */
-                                   : imposed[k];
-        if (used != NULL) used[k] = omega[k];
+        W2s[k] = W2;
+        V2s[k] = V2;
     }
     state->v = v;
     state->f = f;
     state->w2 = W2;
     state->v2 = V2;
-    /* the filter at each sample's break frequency */
-    {
-        Vec3 est = state->g, u = state->u;
-        double last = state->omega_g, t = state->t;
-        for (size_t k = 0; k < n; k++) {
-            const double *y = acc + 3 * k;
-            est = quat_rotate(quat_conjugate(dq[k]), est);
-            u = quat_rotate(quat_conjugate(dq[k]), u);
-            if (last > 0.0) { /* keep e = u/omega_g continuous across a change of omega_g */
-                double ratio = omega[k] / last;
-                u = (Vec3){u.x * ratio, u.y * ratio, u.z * ratio};
-            }
-            last = omega[k];
-            t += Ts;
-            if (t * omega[k] < SQRT2) {
-                /* start-up, within the filter's time constant sqrt 2/omega_g: the mean of the
-                 * accelerometer so far in the gyro frame (no state velocity) */
-                double count = t / Ts;
-                est = (Vec3){est.x + (y[0] - est.x) / count, est.y + (y[1] - est.y) / count,
-                             est.z + (y[2] - est.z) / count};
-                u = (Vec3){0.0, 0.0, 0.0};
-            } else {
-                double Ad[4], Bd[2];
-                Vec3 e = est;
-                butterworth_zoh(omega[k] * Ts, Ad, Bd);
-                est = (Vec3){Bd[0] * y[0] + Ad[0] * e.x + Ad[1] * u.x, Bd[0] * y[1] + Ad[0] * e.y + Ad[1] * u.y,
-                             Bd[0] * y[2] + Ad[0] * e.z + Ad[1] * u.z};
-                u = (Vec3){Bd[1] * y[0] + Ad[2] * e.x + Ad[3] * u.x, Bd[1] * y[1] + Ad[2] * e.y + Ad[3] * u.y,
-                           Bd[1] * y[2] + Ad[2] * e.z + Ad[3] * u.z};
-            }
-            gravity[3 * k] = est.x, gravity[3 * k + 1] = est.y, gravity[3 * k + 2] = est.z;
+}
+
+/* The second pass: the filter over n samples at each sample's break frequency omega (rad/s), the
+ * estimates into gravity (n x 3); state's g, u, omega_g and t carried on. */
+static void filter(WienerLocalState *restrict state, const WienerLocalCoef *restrict coef, size_t n,
+                   const double *restrict acc, const Quat *restrict dq, const double *restrict omega,
+                   double *restrict gravity)
+{
+    const double Ts = coef->Ts;
+    Vec3 est = state->g, u = state->u;
+    double last = state->omega_g, t = state->t;
+    for (size_t k = 0; k < n; k++) {
+        const double *y = acc + 3 * k;
+        est = quat_rotate(quat_conjugate(dq[k]), est);
+        u = quat_rotate(quat_conjugate(dq[k]), u);
+        if (last > 0.0) { /* keep e = u/omega_g continuous across a change of omega_g */
+            double ratio = omega[k] / last;
+            u = (Vec3){u.x * ratio, u.y * ratio, u.z * ratio};
         }
-        state->g = est;
-        state->u = u;
-        state->omega_g = last;
-        state->t = t;
+        last = omega[k];
+        t += Ts;
+        if (t * omega[k] < SQRT2) {
+            /* start-up, within the filter's time constant sqrt 2/omega_g: the mean of the
+             * accelerometer so far in the gyro frame (no state velocity) */
+            double count = t / Ts;
+            est = (Vec3){est.x + (y[0] - est.x) / count, est.y + (y[1] - est.y) / count,
+                         est.z + (y[2] - est.z) / count};
+            u = (Vec3){0.0, 0.0, 0.0};
+        } else {
+            double Ad[4], Bd[2];
+            Vec3 e = est;
+            butterworth_zoh(omega[k] * Ts, Ad, Bd);
+            est = (Vec3){Bd[0] * y[0] + Ad[0] * e.x + Ad[1] * u.x, Bd[0] * y[1] + Ad[0] * e.y + Ad[1] * u.y,
+                         Bd[0] * y[2] + Ad[0] * e.z + Ad[1] * u.z};
+            u = (Vec3){Bd[1] * y[0] + Ad[2] * e.x + Ad[3] * u.x, Bd[1] * y[1] + Ad[2] * e.y + Ad[3] * u.y,
+                       Bd[1] * y[2] + Ad[2] * e.z + Ad[3] * u.z};
+        }
+        gravity[3 * k] = est.x, gravity[3 * k + 1] = est.y, gravity[3 * k + 2] = est.z;
     }
+    state->g = est;
+    state->u = u;
+    state->omega_g = last;
+    state->t = t;
+}
+
+/* The samples of a block (at most WIENER_LOCAL_BLOCK) in three passes, each with a short chain from
+ * sample to sample: the local densities and the break frequencies, the filter, the levelled
+ * orientation. */
+static void block(WienerLocalState *restrict state, const WienerLocalCoef *restrict coef, size_t n,
+                  const double *restrict gyr, const double *restrict acc, const double *restrict imposed,
+                  double *restrict gravity, double *restrict quat, double *restrict used)
+{
+    Quat dq[WIENER_LOCAL_BLOCK];
+    double omega[WIENER_LOCAL_BLOCK], W2s[WIENER_LOCAL_BLOCK], V2s[WIENER_LOCAL_BLOCK];
+    densities(state, coef, n, gyr, acc, dq, W2s, V2s);
+    for (size_t k = 0; k < n; k++) {
+        omega[k] = imposed == NULL ? break_frequency(coef, W2s[k], V2s[k]) : imposed[k];
+        if (used != NULL) used[k] = omega[k];
+    }
+    filter(state, coef, n, acc, dq, omega, gravity);
     /* the orientation: the gyro's, levelled onto each estimate */
-    {
-        Quat q = state->q;
-        for (size_t k = 0; k < n; k++) {
-            const double *e = gravity + 3 * k;
-            q = level_onto_gravity(q, dq[k], (Vec3){e[0], e[1], e[2]});
-            quat_store(q, quat + 4 * k);
-        }
-        state->q = q;
+    Quat q = state->q;
+    for (size_t k = 0; k < n; k++) {
+        const double *e = gravity + 3 * k;
+        q = level_onto_gravity(q, dq[k], (Vec3){e[0], e[1], e[2]});
+        quat_store(q, quat + 4 * k);
     }
+    state->q = q;
 }
 
 void wiener_local_rows(WienerLocalState *state, const WienerLocalCoef *coef, size_t n, const double *gyr,
@@ -191,4 +212,23 @@ void wiener_local_run(WienerLocalState *state, const WienerLocalCoef *coef, cons
                       double gravity[3], double quat[4])
 {
     block(state, coef, 1, gyr, acc, NULL, gravity, quat, NULL);
+}
+
+void wiener_local_gravities(WienerLocalState *states, const WienerLocalCoef *coefs, size_t count, size_t n,
+                            const double *gyr, const double *acc, double *gravity, size_t stride)
+{
+    Quat dq[WIENER_LOCAL_BLOCK];
+    double omega[WIENER_LOCAL_BLOCK], W2s[WIENER_LOCAL_BLOCK], V2s[WIENER_LOCAL_BLOCK];
+    for (size_t k = 0; k < n; k += WIENER_LOCAL_BLOCK) {
+        size_t m = n - k < WIENER_LOCAL_BLOCK ? n - k : WIENER_LOCAL_BLOCK;
+        densities(&states[0], &coefs[0], m, gyr + 3 * k, acc + 3 * k, dq, W2s, V2s);
+        for (size_t c = 0; c < count; c++) {
+            if (c > 0) { /* the densities are the same for each */
+                states[c].v = states[0].v, states[c].f = states[0].f;
+                states[c].w2 = states[0].w2, states[c].v2 = states[0].v2;
+            }
+            for (size_t i = 0; i < m; i++) omega[i] = break_frequency(&coefs[c], W2s[i], V2s[i]);
+            filter(&states[c], &coefs[c], m, acc + 3 * k, dq, omega, gravity + c * stride + 3 * k);
+        }
+    }
 }

@@ -69,4 +69,12 @@ void wiener_local_rows(WienerLocalState *state, const WienerLocalCoef *coef, siz
 void wiener_local_run(WienerLocalState *state, const WienerLocalCoef *coef, const double gyr[3], const double acc[3],
                       double gravity[3], double quat[4]);
 
+/* count filters over the same n samples, filter c as wiener_local_rows runs it from states[c] with
+ * coefs[c], its gravity estimates (n x 3) at gravity + c stride, the densities computed once: the
+ * coefficients share Ts, a_avg and leak_v, and the states their densities (v, f, w2, v2); the
+ * orientation q is neither computed nor carried on (the scale_error choice's candidates,
+ * stages/scale_error.h). count >= 1. */
+void wiener_local_gravities(WienerLocalState *states, const WienerLocalCoef *coefs, size_t count, size_t n,
+                            const double *gyr, const double *acc, double *gravity, size_t stride);
+
 #endif

@@ -21,4 +21,12 @@ double prediction_error(size_t n, const double *gyr, const double *acc, const do
 size_t prediction_errors(size_t n, const double *gyr, const double *acc, const double *gravity, double Ts, size_t m,
                          size_t block, double *work, double *means);
 
+#define PREDICTION_MAX_COUNT 8 /* estimates prediction_errors_of scores at once, at most */
+
+/* prediction_errors_of: prediction_errors of count estimates of gravity (1 to PREDICTION_MAX_COUNT) over the
+ * same rows at once, the orientation integrated once: estimate c's n rows at gravity + c stride, its block
+ * means at means + c ceil((n - m)/block); work: 3 m count doubles. The number of blocks of each. */
+size_t prediction_errors_of(size_t count, size_t n, const double *gyr, const double *acc, const double *gravity,
+                            size_t stride, double Ts, size_t m, size_t block, double *work, double *means);
+
 #endif
