@@ -72,3 +72,53 @@ def test_threads_must_be_at_least_one(recording):
     gyr, acc, _ = recording
     with pytest.raises(ValueError, match="threads must be at least 1, got 0"):
         estimate(gyr[:10], acc[:10], FS, threads=0)
+
+
+@pytest.mark.parametrize("with_mag", [True, False])
+@pytest.mark.parametrize("threads", [1, 2])
+@pytest.mark.parametrize("wait", [0.0, 0.3])
+def test_a_choice_before_the_method_gives_the_run_with_the_chosen_step(recording, with_mag, threads, wait):
+    """run's choose: called once with the threads it may use, before the method's first row, its
+    step then runs the method and the heading: bit for bit the run with that step from the start.
+    On two threads the stages before the method run ahead while it chooses: a choice that takes
+    0.3 s (the first thread far ahead: over 2.5 × 200 000 rows, past the hand-over's 262 144 rows
+    it may lead by) gives the same."""
+    import time
+
+    gyr, acc, mag = (np.concatenate([a, a]) for a in recording)
+    mag = mag if with_mag else None
+    pipeline = configure("wiener", None, gyro_offset=True, heading=with_mag)
+    given = configure("wiener", {"scale_error": 0.001, **({"tau_heading": 7.0} if with_mag else {})},
+                      gyro_offset=True, heading=with_mag)
+    calls = []
+
+    def choose(workers):
+        calls.append(workers)
+        time.sleep(wait)
+        return at(given, 1.0 / FS)
+
+    chosen = run(pipeline, at(pipeline, 1.0 / FS), State(), gyr, acc, mag, threads=threads, choose=choose)
+    assert calls == [1]
+    assert_same(chosen, run(given, at(given, 1.0 / FS), State(), gyr, acc, mag, threads=1))
+    kept = run(pipeline, at(pipeline, 1.0 / FS), State(), gyr, acc, mag, threads=threads, choose=lambda workers: None)
+    assert_same(kept, run(pipeline, at(pipeline, 1.0 / FS), State(), gyr, acc, mag, threads=1))
+
+
+@pytest.mark.parametrize("with_mag", [True, False])
+@pytest.mark.parametrize("threads", [1, 2])
+def test_a_choice_that_fails_stops_the_run_and_says_why(recording, with_mag, threads):
+    """An exception in choose goes on to run's caller, on one thread or two (the first thread,
+    ahead, stops); a step of another configuration is refused."""
+    gyr, acc, mag = recording
+    pipeline = configure("wiener", None, gyro_offset=True, heading=with_mag)
+    step = at(pipeline, 1.0 / FS)
+
+    def fails(workers):
+        raise RuntimeError("no choice")
+
+    with pytest.raises(RuntimeError, match="no choice"):
+        run(pipeline, step, State(), gyr, acc, mag if with_mag else None, threads=threads, choose=fails)
+    other = configure("wiener", {"rest_gyr": 0.5}, gyro_offset=True, heading=with_mag)
+    with pytest.raises(ValueError, match="differ in the method's and the heading's coefficients alone"):
+        run(pipeline, step, State(), gyr, acc, mag if with_mag else None, threads=threads,
+            choose=lambda workers: at(other, 1.0 / FS))

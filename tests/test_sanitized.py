@@ -37,3 +37,9 @@ def test_exported_diagrams_run_clean_on_the_sanitized_build():
     state spaces, continuous ones across a change of step, wiener alone, behind a prefilter and in the
     closed loop, FMU states and forged ones."""
     assert_clean("tests/test_export.py", "-k", "random or continuous or wiener or states")
+
+
+def test_the_one_pass_choice_and_the_choice_beside_the_run_run_clean_on_the_sanitized_build():
+    """scale_error's candidates in one pass (blocks/core/stages/scale_error.c) and a choice made on one
+    thread while the other runs ahead (blocks/core/bindings/threads.cpp)."""
+    assert_clean("tests/test_scale_error.py", "tests/test_batch_threads.py", "-k", "one_pass or choice")

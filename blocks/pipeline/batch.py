@@ -132,9 +132,10 @@ def estimate(
     gyro offset, or with heading up to the method, on one; the rest on the other), the
     outputs bit for bit those of one thread; None (automatic): two for 20 000 rows or more
     where the process may run on two CPUs or more and the gyro offset or the heading runs.
-    The candidates of scale_error's choice (below) run on up to this many threads at once
-    (None: one per CPU the process may run on). Pass 1 where processes already use every CPU
-    (one estimate per worker).
+    scale_error's choice (below) is made on the second of two threads while the first runs the
+    timing and gyro-offset stages ahead; where the pipeline runs on one, its windows run on up to
+    this many threads at once (None: one per CPU the process may run on). Pass 1 where processes
+    already use every CPU (one estimate per worker).
 
     scale_error (wiener with its local densities): unless given, chosen from the recording
     (blocks.stages.scale_error: of its candidates, the one whose estimate predicts the
@@ -162,23 +163,35 @@ def estimate(
         raise ValueError("acc is zero throughout: no gravity to start on")
     if start:
         gyr, acc, mag = gyr[start:], acc[start:], None if mag is None else mag[start:]
-    chosen = None
-    if scale_error.applies(method, dict(pipeline.params)):
-        found = _chosen_scale_error(pipeline, step, gyr, acc, initial_gravity, threads)
-        if found is not None:
-            chosen = {"scale_error": found[0]}
-            if pipeline.heading_params is not None and "tau_heading" not in pipeline.heading_params:
-                chosen["tau_heading"] = _chosen_tau_heading(pipeline, *found)
-            pipeline = check_options(method, {**(params or {}), **chosen}, offline, gyro_offset, mag is not None,
-                                     latency, gyr_samples, acc_samples)
-            step = at(pipeline, 1.0 / fs)
+    chosen = {}
+
+    def chosen_pipeline(workers: int) -> Pipeline | None:
+        """The pipeline with the parameters chosen from the recording (into chosen), None where none is."""
+        found = _chosen_scale_error(pipeline, step, gyr, acc, initial_gravity, workers)
+        if found is None:
+            return None
+        chosen["scale_error"] = found[0]
+        if pipeline.heading_params is not None and "tau_heading" not in pipeline.heading_params:
+            chosen["tau_heading"] = _chosen_tau_heading(pipeline, *found)
+        return check_options(method, {**(params or {}), **chosen}, offline, gyro_offset, mag is not None, latency,
+                             gyr_samples, acc_samples)
+
+    def choose(workers: int) -> Step | None:
+        made = chosen_pipeline(workers)
+        return None if made is None else at(made, 1.0 / fs)
+
+    choosing = scale_error.applies(method, dict(pipeline.params))
     if offline:
+        made = chosen_pipeline(_core.cpus() if threads is None else threads) if choosing else None
+        if made is not None:
+            pipeline, step = made, at(made, 1.0 / fs)
         est = smoothed(pipeline, step, gyr, acc, mag, initial_gravity)
-    else:
-        rows = run(pipeline, step, State(), gyr, acc, mag, initial_gravity=initial_gravity, threads=threads)
+    else:  # the choice made while the stages before the method run (blocks.pipeline.causal.run)
+        rows = run(pipeline, step, State(), gyr, acc, mag, initial_gravity=initial_gravity, threads=threads,
+                   choose=choose if choosing else None)
         est = AttitudeEstimate(rows.gravity, rows.quat, rows.offset, rows.mag_accepted, rows.mag_offset,
                                rows.mag_delay, _mag_delay_source(pipeline, offline=False))
-    est.chosen = chosen
+    est.chosen = chosen or None
     return held_before(est, start)
 
 
@@ -198,9 +211,10 @@ def _chosen_scale_error(pipeline: Pipeline, step: Step, gyr, acc, initial_gravit
     acc = interval_ends(gyr, acc, step.Ts) if pipeline.mean_acc else acc
     found = scale_error.subset(len(gyr), fs)
     windows = None
-    if found is not None:
+    if found is not None:  # the windows' rows, a slice of the recording each
         rows, windows = found
-        gyr, acc = gyr[rows], acc[rows]
+        parts = [slice(rows[first], rows[first] + end - first) for first, _, end in windows]
+        gyr, acc = np.concatenate([gyr[part] for part in parts]), np.concatenate([acc[part] for part in parts])
     variance = np.zeros_like(gyr)
     if pipeline.offset_params is not None:
         offset, variance = offset_estimate(gyr, acc, fs, pipeline.offset_params)
@@ -216,9 +230,10 @@ def _chosen_scale_error(pipeline: Pipeline, step: Step, gyr, acc, initial_gravit
     found = None if per_block is None else scale_error.choose(dict(zip(scale_error.SCALE_ERRORS, per_block)))
     if found is None:
         return None
-    counted = np.concatenate([np.arange(scored, end) for _, scored, end in windows or [(0, 0, len(gyr))]])
-    return (found[0], float(np.mean(np.einsum("ij,ij->i", gyr[counted], gyr[counted]))),
-            float(np.mean(variance[counted])))
+    scored = [slice(first, end) for _, first, end in windows or [(0, 0, len(gyr))]]
+    rates = np.concatenate([gyr[part] for part in scored])
+    return (found[0], float(np.mean(np.einsum("ij,ij->i", rates, rates))),
+            float(np.mean(np.concatenate([variance[part] for part in scored]))))
 
 
 def _chosen_tau_heading(pipeline: Pipeline, value: float, rate_ms: float, offset_variance: float) -> float:

@@ -123,7 +123,7 @@ class Rows:
 
 
 def run(pipeline: Pipeline, step: Step, state: State, gyr, acc, mag=None, out: Rows | None = None,
-        initial_gravity=None, threads: int | None = None) -> Rows:
+        initial_gravity=None, threads: int | None = None, choose=None) -> Rows:
     """The rows gyr (N×3, rad/s), acc (N×3, m/s²) and, where the heading stage runs, mag
     (N×3, µT; a row with a NaN, or all 0, has no field sample) through stages 1–5, state
     carried on; the outputs into out (Rows.empty(pipeline, N) if None). Finite gyr and acc.
@@ -134,9 +134,18 @@ def run(pipeline: Pipeline, step: Step, state: State, gyr, acc, mag=None, out: R
     stages split over two (a chunk of rows through the first stages on one while the rest
     take the chunks before it, the outputs bit for bit those of one thread); None: two from
     20 000 rows on where the process may run on two CPUs or more and the gyro-offset or heading
-    stage runs."""
+    stage runs. choose: None, or choose(threads) → a Step (or None: step) of the same
+    configuration but for the method's and the heading's parameters, called once before the
+    method's first row with the threads it may use (1 where the stages run on beside it: on
+    two threads the timing and gyro-offset stages run ahead while it chooses); the method and
+    the heading then run with that step."""
     out = Rows.empty(pipeline, len(gyr)) if out is None else out
     _core.run(pipeline.core, step.core, state, gyr, acc, mag, None if initial_gravity is None else
               np.asarray(initial_gravity, dtype=float), out.gravity, out.quat, out.offset, out.offset_variance,
-              out.mag_accepted, out.mag_offset, out.mag_delay, threads)
+              out.mag_accepted, out.mag_offset, out.mag_delay, threads,
+              None if choose is None else lambda workers: _core_step(choose(workers)))
     return out
+
+
+def _core_step(step: Step | None) -> _core.Step | None:
+    return None if step is None else step.core

@@ -64,7 +64,7 @@ Array array_of(const double *values, std::initializer_list<size_t> shape)
     size_t n = 1;
     for (size_t s : shape) n *= s;
     double *data = new double[n];
-    std::memcpy(data, values, n * sizeof(double));
+    if (n > 0) std::memcpy(data, values, n * sizeof(double)); // (values may be null where there are none)
     nb::capsule owner(data, [](void *p) noexcept { delete[] static_cast<double *>(p); });
     return Array(data, shape, owner);
 }
@@ -464,7 +464,8 @@ void bind_pipeline(nb::module_ &m)
         [](const AfPipeline &p, const AfStep &step, AfState &state, Rows3 gyr, Rows3 acc, std::optional<Rows3> mag,
            std::optional<Vec> initial_gravity, Out3 gravity, Out4 quat, std::optional<Out3> offset,
            std::optional<Out3> offset_variance, std::optional<Out<bool, nb::shape<-1>>> mag_accepted,
-           std::optional<Out3> mag_offset, std::optional<Out1> mag_delay, std::optional<int> threads) {
+           std::optional<Out3> mag_offset, std::optional<Out1> mag_delay, std::optional<int> threads,
+           nb::object choose) {
             size_t n = gyr.shape(0);
             if (threads && *threads < 1)
                 throw nb::value_error(("threads must be at least 1, got " + std::to_string(*threads)).c_str());
@@ -484,17 +485,36 @@ void bind_pipeline(nb::module_ &m)
                            mag_offset ? mag_offset->data() : nullptr, mag_delay ? mag_delay->data() : nullptr};
             const AfInputs in = {gyr.data(), acc.data(), mag ? mag->data() : nullptr,
                                  initial_gravity ? initial_gravity->data() : nullptr};
+            Choice chooser;
+            if (!choose.is_none())
+                chooser = [&choose, &step, &p](AfStep &chosen, int workers) {
+                    nb::gil_scoped_acquire locked;
+                    nb::object made = choose(workers);
+                    if (made.is_none()) return;
+                    const AfStep &s = nb::cast<const AfStep &>(made);
+                    if (s.Ts != step.Ts || s.stepper.kernel != step.stepper.kernel ||
+                        s.stepper.state_size != step.stepper.state_size ||
+                        (p.offset_runs && std::memcmp(&s.offset_coef, &step.offset_coef, sizeof s.offset_coef) != 0))
+                        throw nb::value_error("the chosen step must differ in the method's and the heading's "
+                                              "coefficients alone");
+                    chosen.stepper = s.stepper;
+                    chosen.heading_coef = s.heading_coef;
+                };
             nb::gil_scoped_release released;
-            pipelined_run(p, step, state, n, in, rows, threads.value_or(0));
+            pipelined_run(p, step, state, n, in, rows, threads.value_or(0), chooser);
         },
         "pipeline"_a, "step"_a, "state"_a, "gyr"_a, "acc"_a, "mag"_a.none(), "initial_gravity"_a.none(),
         "gravity"_a.noconvert(), "quat"_a.noconvert(), "offset"_a.noconvert().none(),
         "offset_variance"_a.noconvert().none(), "mag_accepted"_a.noconvert().none(),
         "mag_offset"_a.noconvert().none(), "mag_delay"_a.noconvert().none(), "threads"_a.none() = nb::none(),
+        "choose"_a.none() = nb::none(),
         "The rows gyr (N x 3, rad/s), acc (N x 3, m/s^2) and mag (N x 3, uT, or None) through the pipeline's "
         "stages, state carried on; the outputs written into the arrays given (None: not wanted). threads: at "
         "most this many (the stages split over two at most; the outputs are the same on any number); None: two "
-        "from 20 000 rows on where the process may run on two CPUs or more.");
+        "from 20 000 rows on where the process may run on two CPUs or more. choose (None: none): "
+        "choose(threads) gives the Step to run the method and the heading with (None: step), made before the "
+        "method's first row with up to that many threads; on two threads while the first runs the timing and "
+        "gyro-offset stages ahead.");
 
     m.def(
         "smooth",
