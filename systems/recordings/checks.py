@@ -41,7 +41,7 @@ def field_norm_note(rec: Recording) -> str | None:
     in any unit; only the hard-iron offset is then reported in the input's unit."""
     if rec.mag is None:
         return None
-    rows = rec.mag[np.isfinite(rec.mag).all(axis=1)]  # read_recording leaves no magnetometer without a sample
+    rows = rec.mag[all_of_row(np.isfinite(rec.mag))]  # read_recording leaves no magnetometer without a sample
     norm = float(np.median(np.linalg.norm(rows, axis=1)))
     low, high = EARTH_FIELD_RANGE_UT
     if low / 2 <= norm <= 2 * high:
@@ -63,6 +63,17 @@ def other_unit(units: dict, given: str, value: float, plausible) -> str | None:
     return next((u for u, factor in units.items() if u != given and plausible(value / units[given] * factor)), None)
 
 
+def all_of_row(mask: np.ndarray) -> np.ndarray:
+    """(N, bool) whether each row of mask (N×3, bool) is all True: mask.all(axis=1), column by column
+    (numpy's reduction over a row of 3 takes several times as long on a long recording)."""
+    return mask[:, 0] & mask[:, 1] & mask[:, 2]
+
+
+def any_of_row(mask: np.ndarray) -> np.ndarray:
+    """(N, bool) whether any of each row of mask (N×3, bool) is True, column by column (as all_of_row)."""
+    return mask[:, 0] | mask[:, 1] | mask[:, 2]
+
+
 def check_shapes(rec: Recording) -> None:
     for name in ("gyr", "acc"):
         a = getattr(rec, name)
@@ -74,7 +85,7 @@ def check_shapes(rec: Recording) -> None:
 def beyond_range(a, bound: float) -> np.ndarray:
     """(N, bool) the rows of a (N×3) with a finite value beyond ±bound."""
     with np.errstate(invalid="ignore"):
-        return (np.isfinite(a) & (np.abs(a) > bound)).any(axis=1)
+        return any_of_row(np.isfinite(a) & (np.abs(a) > bound))
 
 
 def fill_invalid(rec: Recording, max_gap: float) -> None:
@@ -82,10 +93,12 @@ def fill_invalid(rec: Recording, max_gap: float) -> None:
     beyond every IMU's range (MAX_GYR_RAD_S, MAX_ACC_M_S2 per axis: spikes), in runs of
     rows up to max_gap seconds between valid rows, interpolated linearly in place, and
     noted; at the first or last row, or in a longer run, refused."""
-    beyond = beyond_range(rec.gyr, MAX_GYR_RAD_S) | beyond_range(rec.acc, MAX_ACC_M_S2)
-    bad_rows = ~(np.isfinite(rec.gyr).all(axis=1) & np.isfinite(rec.acc).all(axis=1)) | beyond
-    if not bad_rows.any():
+    with np.errstate(invalid="ignore"):  # |v| <= bound: False where v is not finite
+        valid = all_of_row(np.abs(rec.gyr) <= MAX_GYR_RAD_S) & all_of_row(np.abs(rec.acc) <= MAX_ACC_M_S2)
+    if valid.all():
         return
+    beyond = beyond_range(rec.gyr, MAX_GYR_RAD_S) | beyond_range(rec.acc, MAX_ACC_M_S2)
+    bad_rows = ~valid
     what = {(False, True): "not finite", (True, False): f"beyond every IMU's range ({RANGES})",
             (True, True): f"not finite or beyond every IMU's range ({RANGES})"}[
         beyond.any(), (bad_rows & ~beyond).any()]
@@ -133,11 +146,17 @@ def hold_until_gravity(rec: Recording) -> None:
 def typical_peak(values) -> float:
     """The largest of values (finite ones) once the few largest are set aside as spikes
     (SPIKES): what the sensor reaches, not what one bad sample says."""
-    v = values[np.isfinite(values)]
+    finite = np.isfinite(values)
+    v = values if finite.all() else values[finite]
     k = max(SPIKES[0], int(SPIKES[1] * len(v)))
     if len(v) <= k:
         return float(v.max()) if len(v) else 0.0
     return float(np.partition(v, len(v) - k - 1)[len(v) - k - 1])
+
+
+def _repeats(values) -> float:
+    """The share of values that repeat the one before (1 for fewer than two)."""
+    return float(np.mean(values[1:] == values[:-1])) if len(values) > 1 else 1.0
 
 
 def saturation_notes(rec: Recording) -> dict:
@@ -152,12 +171,12 @@ def saturation_notes(rec: Recording) -> dict:
         clipped = []
         for axis, column in zip("xyz", np.abs(getattr(rec, name)).T):
             peak = float(column.max())
+            if not peak >= SATURATION_LEAST[name]:
+                continue
             held = column == peak
             edges = np.diff(np.concatenate([[0], held.astype(np.int8), [0]]))
             longest = int((np.flatnonzero(edges < 0) - np.flatnonzero(edges > 0)).max())
-            others = column[~held]
-            repeats = np.mean(others[1:] == others[:-1]) if len(others) > 1 else 1.0
-            if peak >= SATURATION_LEAST[name] and longest >= max(3, SATURATION_S * rec.fs) and repeats < 0.5:
+            if longest >= max(3, SATURATION_S * rec.fs) and _repeats(column[~held]) < 0.5:
                 clipped.append(f"{axis} at ±{peak:.4g} {unit} for up to {1e3 * longest / rec.fs:.0f} ms "
                                f"({int(held.sum())} samples)")
         if clipped:
@@ -183,17 +202,17 @@ def pile_up_notes(rec: Recording, skip=()) -> list[str]:
             continue
         piled = []
         for axis, column in zip("xyz", getattr(rec, name).T):
+            finite = np.isfinite(column)
+            column = column if finite.all() else column[finite]
             for sign in (1.0, -1.0):
-                v = sign * column[np.isfinite(column)]
+                v = column if sign > 0 else -column
                 peak = float(v.max()) if len(v) else 0.0
                 if peak < SATURATION_LEAST[name]:
                     continue
                 at = v >= peak * (1 - PILE_BAND)
                 inside = np.count_nonzero((v >= peak * (1 - (1 + PILE_INSIDE) * PILE_BAND)) & ~at)
-                others = v[~at]
-                repeats = np.mean(others[1:] == others[:-1]) if len(others) > 1 else 1.0
                 least = max(PILE_LEAST[0], PILE_LEAST[1] * len(v))
-                if at.sum() >= max(least, PILE_RATIO * inside) and repeats < 0.5:
+                if at.sum() >= max(least, PILE_RATIO * inside) and _repeats(v[~at]) < 0.5:
                     piled.append(f"{axis} at {sign * peak:+.4g} {'rad/s' if name == 'gyr' else 'm/s²'} "
                                  f"({_usual_range(name, peak)}): {int(at.sum())} samples, {at.mean():.1%} of them, "
                                  f"within {PILE_BAND:.1%} of it against {inside} in the "
@@ -225,10 +244,11 @@ def mark_held(rec: Recording) -> None:
     interpolated) is read as it is."""
     if rec.mag is None:
         return
-    rows = np.flatnonzero(np.isfinite(rec.mag).all(axis=1))
+    rows = np.flatnonzero(all_of_row(np.isfinite(rec.mag)))
     if len(rows) < 3:
         return
-    same = (rec.mag[rows[1:]] == rec.mag[rows[:-1]]).all(axis=1)
+    every = len(rows) == len(rec.mag)  # (then the rows as slices, not copies)
+    same = all_of_row((rec.mag[1:] == rec.mag[:-1]) if every else (rec.mag[rows[1:]] == rec.mag[rows[:-1]]))
     new = np.concatenate([rows[:1], rows[1:][~same]])
     if len(new) < 2 or np.median(np.diff(new)) < 2:
         return
@@ -247,12 +267,14 @@ def check_values(rec: Recording, gyr_unit: str, acc_unit: str) -> None:
     with the flag that fixes it; an accelerometer without gravity (median norm below
     NO_GRAVITY_M_S2) is refused; other values no unit explains (a sensor shaken far harder
     than a person moves) are noted, and read as they are."""
-    finite = np.isfinite(rec.gyr).all(axis=1) & np.isfinite(rec.acc).all(axis=1)
+    finite = all_of_row(np.isfinite(rec.gyr)) & all_of_row(np.isfinite(rec.acc))
     if not finite.any():
         return  # fill_invalid refuses it
-    peak = typical_peak(np.abs(rec.gyr[finite]).max(axis=1))
+    rows = slice(None) if finite.all() else finite  # (no copies where every row is)
+    magnitude = np.abs(rec.gyr[rows])
+    peak = typical_peak(np.maximum(np.maximum(magnitude[:, 0], magnitude[:, 1]), magnitude[:, 2]))
     with np.errstate(over="ignore"):  # a norm beyond the largest float is inf, as far from gravity
-        norm = float(np.median(np.linalg.norm(rec.acc[finite], axis=1)))
+        norm = float(np.median(np.linalg.norm(rec.acc[rows], axis=1)))
     for flag, units, given, value, plausible, what in (
         ("--gyr-unit", GYR_UNITS, gyr_unit, peak, lambda p: p <= MAX_GYR_RAD_S,
          f"gyro reaches {peak:.1f} rad/s read as {gyr_unit}, beyond any MEMS gyro"),

@@ -15,6 +15,7 @@ import numpy as np
 
 from attitude_fmu.systems.recordings.axes import axes_notes, parse_axes
 from attitude_fmu.systems.recordings.checks import (
+    any_of_row,
     check_rate,
     check_shapes,
     check_values,
@@ -114,7 +115,7 @@ def read_recording(path, fs: float | None = None, gyr_unit: str | None = None, a
     rec.gyr *= GYR_UNITS[gyr_unit]  # in place: the recording's arrays are its own
     rec.acc *= ACC_UNITS[acc_unit]
     mark_held(rec)
-    if rec.mag is not None and np.isnan(rec.mag).any(axis=1).all():
+    if rec.mag is not None and any_of_row(np.isnan(rec.mag)).all():
         rec.mag = None
         rec.notes.append(f"{rec.name}: the magnetometer has no sample (NaN throughout); heading from the gyro")
     if rec.mag is not None:

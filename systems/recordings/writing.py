@@ -1,6 +1,7 @@
 """Estimates and recordings out: the writer (CSV, or Parquet by the file name's suffix) and its columns."""
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -87,15 +88,26 @@ def write_table(path, blocks) -> None:
     parquet = Path(str(path)).suffix.lower() == PARQUET_SUFFIX
     schema = pa.schema([(n, pa.float64()) for n in names])
 
+    def rows_batch(start: int):
+        rows = slice(start, start + ROWS_PER_BATCH)
+        columns = []
+        for _, values in blocks:
+            values = values(rows) if callable(values) else values[rows]
+            columns += [np.ascontiguousarray(c, dtype=float) for c in values.T]
+        return pa.RecordBatch.from_arrays([_arrow(c if parquet or j == 0 else significant(c))  # 0: t
+                                           for j, c in enumerate(columns)], schema=schema)
+
     def batches():
-        for start in range(0, n_rows, ROWS_PER_BATCH):
-            rows = slice(start, start + ROWS_PER_BATCH)
-            columns = []
-            for _, values in blocks:
-                values = values(rows) if callable(values) else values[rows]
-                columns += [np.ascontiguousarray(c, dtype=float) for c in values.T]
-            yield pa.RecordBatch.from_arrays([_arrow(c if parquet or j == 0 else significant(c))  # 0: t
-                                              for j, c in enumerate(columns)], schema=schema)
+        """The batches in order, each made on a thread while the one before is written."""
+        with ThreadPoolExecutor(max_workers=1) as pool:
+            made = None
+            for start in range(0, n_rows, ROWS_PER_BATCH):
+                following = pool.submit(rows_batch, start)
+                if made is not None:
+                    yield made.result()
+                made = following
+            if made is not None:
+                yield made.result()
 
     with replaced(path) as fh:
         if parquet:
