@@ -1,6 +1,7 @@
 """Estimates and recordings out: the writer (CSV, or Parquet by the file name's suffix) and its columns."""
 from __future__ import annotations
 
+from collections import deque
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
@@ -20,6 +21,7 @@ OUTPUT_COLUMNS = ("t", "q_w", "q_x", "q_y", "q_z", "g_x", "g_y", "g_z")
 EULER_COLUMNS = ("roll_deg", "pitch_deg", "yaw_deg")  # with --euler
 CSV_DIGITS = 10  # significant digits of the CSV's estimates (t and Parquet keep every bit)
 ROWS_PER_BATCH = 1 << 16  # rows converted and written at a time: memory stays small whatever the length
+CSV_THREADS = 2  # threads that turn a CSV's batches into text at once
 
 
 def euler_degrees(quat) -> np.ndarray:
@@ -80,7 +82,9 @@ def write_table(path, blocks) -> None:
     PARQUET_SUFFIX gets a Parquet file (float64, every bit), any other a CSV (the first
     column with the digits that read back to its every bit, up to 17: epoch time stamps
     keep their steps; the others CSV_DIGITS significant digits); "-" the CSV on standard
-    output. Written by systems.recordings.output.replaced: complete, or not at all."""
+    output. Written by systems.recordings.output.replaced: complete, or not at all; in batches
+    of ROWS_PER_BATCH rows, each made (and a CSV's turned into text, on CSV_THREADS threads) while
+    the ones before are written."""
     import pyarrow as pa
 
     names = [n for columns, _ in blocks for n in columns]
@@ -97,33 +101,40 @@ def write_table(path, blocks) -> None:
         return pa.RecordBatch.from_arrays([_arrow(c if parquet or j == 0 else significant(c))  # 0: t
                                            for j, c in enumerate(columns)], schema=schema)
 
-    def batches():
-        """The batches in order, each made on a thread while the one before is written."""
-        with ThreadPoolExecutor(max_workers=1) as pool:
-            made = None
-            for start in range(0, n_rows, ROWS_PER_BATCH):
-                following = pool.submit(rows_batch, start)
-                if made is not None:
-                    yield made.result()
-                made = following
-            if made is not None:
-                yield made.result()
-
     with replaced(path) as fh:
         if parquet:
             import pyarrow.parquet as pq
 
             with pq.ParquetWriter(fh, schema, use_dictionary=False) as writer:  # measurements do not repeat
-                for batch in batches():
+                for batch in _in_order(rows_batch, range(0, n_rows, ROWS_PER_BATCH), 1):
                     writer.write_batch(batch)
             return
         import pyarrow.csv as pc
 
-        fh.write((",".join(names) + "\n").encode())  # the header unquoted, as the columns are
         options = pc.WriteOptions(include_header=False, quoting_style="none")
-        with pc.CSVWriter(fh, schema, write_options=options) as writer:
-            for batch in batches():
-                writer.write_batch(batch)
+
+        def text(start: int):
+            sink = pa.BufferOutputStream()
+            pc.write_csv(rows_batch(start), sink, write_options=options)
+            return sink.getvalue()
+
+        fh.write((",".join(names) + "\n").encode())  # the header unquoted, as the columns are
+        for part in _in_order(text, range(0, n_rows, ROWS_PER_BATCH), CSV_THREADS):
+            fh.write(part)
+
+
+def _in_order(make, starts, threads: int):
+    """make(start) for each of starts, in their order, made on up to `threads` threads (pyarrow
+    and numpy run without Python's lock) while the ones before are written: at most two per
+    thread at a time, so that memory stays small whatever the length."""
+    with ThreadPoolExecutor(max_workers=threads) as pool:
+        pending = deque()
+        for start in starts:
+            pending.append(pool.submit(make, start))
+            if len(pending) > 2 * threads:
+                yield pending.popleft().result()
+        while pending:
+            yield pending.popleft().result()
 
 
 def write_recording(path, rec) -> None:
