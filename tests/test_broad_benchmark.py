@@ -153,7 +153,7 @@ def test_the_attached_magnet_scaled_down_is_taken_or_left_to_the_guard(scale):
     magnet), smoothed over 1 s. From 7 µT up it is taken as hard iron, within 1 µT; the
     2 µT of 3 cm stays with the guard. The heading stays within 2° either way; offline,
     where a taken offset holds from where the magnet was put on, it is below 0.7 of the
-    online figure."""
+    online figure, each with its constant north offset removed."""
     pytest.importorskip("vqf")
     import vqf
     from scipy.ndimage import uniform_filter1d
@@ -173,8 +173,8 @@ def test_the_attached_magnet_scaled_down_is_taken_or_left_to_the_guard(scale):
     mag = rec.mag - (1.0 - scale) * magnet
     est = estimate(rec.gyr, rec.acc, rec.fs, gyro_offset=True, mag=mag)
     heading = errors_on_movement(est.quat, rec)["heading_rmse_deg"]
-    offline = errors_on_movement(estimate(rec.gyr, rec.acc, rec.fs, gyro_offset=True, mag=mag, offline=True).quat,
-                                 rec)["heading_rmse_deg"]
+    offline_quat = estimate(rec.gyr, rec.acc, rec.fs, gyro_offset=True, mag=mag, offline=True).quat
+    offline = errors_on_movement(offline_quat, rec)["heading_rmse_deg"]
     peer = vqf.VQF(1.0 / rec.fs).updateBatch(np.ascontiguousarray(rec.gyr), np.ascontiguousarray(rec.acc),
                                              np.ascontiguousarray(mag))["quat9D"]
     on = slice(int(50 * rec.fs), int(85 * rec.fs))  # the magnet on, the sensor turning
@@ -186,7 +186,13 @@ def test_the_attached_magnet_scaled_down_is_taken_or_left_to_the_guard(scale):
         taken = used[on]
         assert taken.any()
         assert np.abs(est.mag_offset[on][taken] - scale * magnet[on][taken]).max() < 1.0
-        assert offline < 0.7 * heading  # offline the offset holds from where the magnet was put on
+        # offline the offset holds from where the magnet was put on; compared with the constant north offset
+        # removed from each (the field where the sensor moves is off that at the rest spot, which the reference's
+        # north matches, and the offline heading, smoothed both ways, follows the former throughout)
+        off, on_line = (errors_on_movement(q, rec, magnetic_north=False)["heading_rmse_deg"] for q in (offline_quat,
+                                                                                                      est.quat))
+        print(f"without the north offset: heading {on_line:.2f}°, offline {off:.2f}°")
+        assert off < 0.7 * on_line
     else:
         assert not used.any()
     assert heading < 2.0 and offline < 2.0

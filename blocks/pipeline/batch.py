@@ -21,7 +21,7 @@ from attitude_fmu.blocks.stages.delays import mag_delay
 from attitude_fmu.blocks.stages.gyro_offset import correct as correct_gyro
 from attitude_fmu.blocks.stages.gyro_offset import offset_estimate
 from attitude_fmu.blocks.stages.hard_iron import back_dated
-from attitude_fmu.blocks.stages.heading import with_magnetometer
+from attitude_fmu.blocks.stages.heading import smoothed_with_magnetometer
 from attitude_fmu.blocks.stages.timing import carry_forward_rows, interval_ends, interval_means
 
 
@@ -150,7 +150,10 @@ def estimate(
     offset comes from passes forward and backward in time; the magnetometer's delay is
     measured from the whole recording (blocks.stages.delays.mag_delay; 0 where it cannot
     be or comes out negative) and each hard-iron offset the heading stage took or dropped
-    holds from where the field changed (blocks.stages.hard_iron.back_dated).
+    holds from where the field changed (blocks.stages.hard_iron.back_dated); the heading
+    stage runs forward and backward in time, each row's correction the passes' weighted
+    mean (blocks.stages.heading.smoothed_with_magnetometer), mag_accepted where either used
+    the field.
     """
     pipeline = check_options(method, params, offline, gyro_offset, mag is not None, latency, gyr_samples,
                              acc_samples)
@@ -289,19 +292,19 @@ def smoothed(pipeline: Pipeline, step: Step, gyr, acc, mag, initial_gravity=None
 
 
 def _offline_heading(est: AttitudeEstimate, pipeline: Pipeline, mag, gyr, fs: float) -> None:
-    """The heading stage over the whole recording, in place: the magnetometer's delay
-    measured unless given, then once more with each hard-iron offset from where the field
-    changed, on the field freed of it."""
+    """The heading stage smoothed over the whole recording, in place: the magnetometer's
+    delay measured unless given, then once more with each hard-iron offset from where the
+    field changed, on the field freed of it."""
     params = dict(pipeline.heading_params)
     est.mag_delay_source = _mag_delay_source(pipeline, offline=True)
     if est.mag_delay_source == "measured":
         params["mag_delay"] = max(mag_delay(gyr, mag, fs) or 0.0, 0.0)
     quat = est.quat
-    est.quat, est.mag_accepted, est.mag_offset, est.mag_delay = with_magnetometer(quat, mag, fs, params)
+    est.quat, est.mag_accepted, est.mag_offset, est.mag_delay = smoothed_with_magnetometer(quat, mag, fs, params)
     if est.mag_offset.any():  # again, with each hard-iron offset from where the field changed
         est.mag_offset = back_dated(mag, est.mag_offset, fs, heading_stage.resolve(params))
         freed = mag - est.mag_offset
         if est.mag_delay_source == "measured":  # the offset no longer hides the delay
             params["mag_delay"] = max(mag_delay(gyr, freed, fs) or 0.0, 0.0)
-        est.quat, est.mag_accepted, _, est.mag_delay = with_magnetometer(quat, freed, fs,
-                                                                         {**params, "mag_cal_time": 0.0})
+        est.quat, est.mag_accepted, _, est.mag_delay = smoothed_with_magnetometer(quat, freed, fs,
+                                                                                  {**params, "mag_cal_time": 0.0})

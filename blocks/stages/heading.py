@@ -111,3 +111,17 @@ def with_magnetometer(quat, mag, fs: float, params=None):
     _core.heading_run(initial_state(), coefficients(resolve(params), 1.0 / fs), quat,
                       np.ascontiguousarray(mag, dtype=float), out, accepted, offset, delay)
     return out, accepted, offset, delay
+
+
+def smoothed_with_magnetometer(quat, mag, fs: float, params=None):
+    """with_magnetometer's outputs with the heading smoothed over the whole recording: the
+    stage forward, then backward in time, each row's correction the two passes' averaged,
+    weighted by what each has seen (blocks/core/pipeline/offline.h: offline_heading); accepted:
+    used by either pass; the hard-iron offset and delay the forward pass's. params must give
+    mag_delay (s; ValueError otherwise): backward in time the field leads the gyro by it."""
+    quat = np.ascontiguousarray(quat, dtype=float)
+    n = len(quat)
+    out, accepted, offset, delay = np.empty((n, 4)), np.empty(n, dtype=np.bool_), np.empty((n, 3)), np.empty(n)
+    _core.heading_smooth(coefficients(resolve(params), 1.0 / fs), quat, np.ascontiguousarray(mag, dtype=float),
+                         out, accepted, offset, delay)
+    return out, accepted, offset, delay

@@ -18,6 +18,7 @@ extern "C" {
 #include "stages/delays.h"
 #include "stages/gyro_offset.h"
 #include "stages/heading.h"
+#include "pipeline/offline.h"
 #include "stages/prediction.h"
 #include "stages/timing.h"
 }
@@ -63,6 +64,19 @@ void check_rows(size_t rows, size_t n, const char *what)
     if (rows != n)
         throw nb::value_error((std::string(what) + " has " + std::to_string(rows) + " rows, not " + std::to_string(n))
                                   .c_str());
+}
+
+/* the heading stage's rows: quat's count, which mag, out, accepted, offset and delay must have */
+size_t heading_rows(const Rows4 &quat, const Rows3 &mag, const Rows4 &out, const Flags &accepted, const Rows3 &offset,
+                    const Vector &delay)
+{
+    size_t n = quat.shape(0);
+    check_rows(mag.shape(0), n, "mag");
+    check_rows(out.shape(0), n, "out");
+    check_rows(accepted.shape(0), n, "accepted");
+    check_rows(offset.shape(0), n, "offset");
+    check_rows(delay.shape(0), n, "delay");
+    return n;
 }
 
 /* text with its first occurrence of from replaced by to */
@@ -206,12 +220,7 @@ void bind_stages(nb::module_ &m)
                             Flags accepted, Rows3 offset, Vector delay) {
         AfHeading *s = as<AfHeading>(state, "state");
         const AfHeadingCoef *c = as<AfHeadingCoef>(coef, "coef");
-        size_t n = quat.shape(0);
-        check_rows(mag.shape(0), n, "mag");
-        check_rows(out.shape(0), n, "out");
-        check_rows(accepted.shape(0), n, "accepted");
-        check_rows(offset.shape(0), n, "offset");
-        check_rows(delay.shape(0), n, "delay");
+        size_t n = heading_rows(quat, mag, out, accepted, offset, delay);
         nb::gil_scoped_release unlocked;
         heading_run(s, c, n, quat.data(), mag.data(), out.data(), reinterpret_cast<unsigned char *>(accepted.data()),
                     offset.data(), delay.data());
@@ -221,6 +230,21 @@ void bind_stages(nb::module_ &m)
           "orientation with magnetometer heading into out (N×4; may be quat), whether the field was used into\n"
           "accepted (N), the hard-iron estimate into offset (N×3) and the delay allowed for (s) into delay\n"
           "(N); state in place.");
+
+    m.def("heading_smooth", [](const Vector &coef, const Rows4 &quat, const Rows3 &mag, Rows4 out, Flags accepted,
+                               Rows3 offset, Vector delay) {
+        const AfHeadingCoef *c = as<AfHeadingCoef>(coef, "coef");
+        size_t n = heading_rows(quat, mag, out, accepted, offset, delay);
+        if (n > 0 && out.data() == quat.data()) throw nb::value_error("out must not be quat");
+        if (std::isnan(c->delay)) throw nb::value_error("the smoothed heading needs mag_delay given");
+        nb::gil_scoped_release unlocked;
+        offline_heading(c, n, quat.data(), mag.data(), out.data(), reinterpret_cast<unsigned char *>(accepted.data()),
+                        offset.data(), delay.data());
+    }, nb::arg("coef"), nb::arg("quat"), nb::arg("mag"), nb::arg("out").noconvert(), nb::arg("accepted").noconvert(),
+          nb::arg("offset").noconvert(), nb::arg("delay").noconvert(),
+          "The heading stage smoothed forward and backward in time (blocks/core/pipeline/offline.h) over N samples\n"
+          "quat (N×4) and mag (N×3), coef's mag_delay given: out (N×4, not quat), accepted (N: used by either\n"
+          "pass), the forward pass's hard-iron estimate offset (N×3) and delay (N, s) written.");
 
     // ---- sample timing and latency
     m.attr("STEP_TOLERANCE") = STEP_TOLERANCE;

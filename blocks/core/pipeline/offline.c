@@ -79,3 +79,50 @@ void offline_smooth(const AfStepper *stepper, size_t n, const double *gyr, const
     for (size_t k = 0; k < n; k++)
         level_onto(quat + 4 * k, gravity + 3 * k, quat + 4 * k);
 }
+
+/* the heading correction (rad) that turned q into out about earth up: psi of out (x) q^-1 = Rz(psi) */
+static double correction(const double q[4], const double out[4])
+{
+    Quat d = quat_multiply(quat_load(out), quat_conjugate(quat_load(q)));
+    return 2.0 * atan2(d.z, d.w);
+}
+
+/* a pass's weight, t the steps since its first used field sample (negative: none yet) */
+static double pass_weight(double steps, const AfHeadingCoef *coef)
+{
+    return steps < 0.0 ? 0.0 : 1.0 - exp(-(steps + 1.0) * coef->rate_heading);
+}
+
+int offline_heading(const AfHeadingCoef *coef, size_t n, const double *quat, const double *mag, double *out,
+                    unsigned char *accepted, double *offset, double *delay)
+{
+    if (isnan(coef->delay))
+        return -1;
+    AfHeading state;
+    heading_initial_state(&state);
+    heading_run(&state, coef, n, quat, mag, out, accepted, offset, delay);
+    size_t first = n; /* the forward pass's first used field sample */
+    for (size_t k = 0; k < n && first == n; k++)
+        first = accepted[k] ? k : n;
+    AfHeadingCoef back = *coef;
+    back.delay = -coef->delay;
+    heading_initial_state(&state);
+    size_t last = n; /* the backward pass's first used field sample (the latest row) */
+    for (size_t j = 0; j < n; j++) {
+        size_t k = n - 1 - j;
+        double q_back[4];
+        int ok;
+        heading_step(&state, &back, quat + 4 * k, mag + 3 * k, q_back, &ok);
+        if (ok && last == n)
+            last = k;
+        double forward = correction(quat + 4 * k, out + 4 * k);
+        double w_f = pass_weight(first <= k ? (double)(k - first) : -1.0, coef);
+        double w_b = pass_weight(last < n ? (double)(last - k) : -1.0, coef);
+        double psi = forward;
+        if (w_b > 0.0)
+            psi += w_b / (w_f + w_b) * remainder(state.psi_c - forward, 2.0 * 3.14159265358979323846);
+        quat_store(quat_multiply(rotvec_quat(0.0, 0.0, psi), quat_load(quat + 4 * k)), out + 4 * k);
+        accepted[k] = (unsigned char)(accepted[k] | ok);
+    }
+    return 0;
+}
