@@ -8,7 +8,9 @@ a = 1 − exp(−Ts/tau) and the innovation clipped to ±heading_clip (a robust 
 disturbance that slips through the guard pulls by at most heading_clip/tau_heading per
 second). Start-up: over the first tau_heading seconds every sample is used, unclipped,
 with the weight 1/n of a running mean, and the reference norm and dip are their running
-means (the first samples may come in motion, while the tilt is still settling). The field
+means (the first samples may come in motion, while the tilt is still settling); ψ_c's
+running mean takes each sample's own heading, not the low-passed field's (below), in which
+a tilt still settling would linger. The field
 the heading follows and the guard judges is the tilt-compensated one (earth frame) through a
 first-order low-pass of tau_mag_guard: a field fixed in the earth frame passes unchanged, the
 sensor's noise is averaged (a fast, noisy magnetometer's samples would otherwise leave the

@@ -228,7 +228,8 @@ static double guard_rate(const AfHeading *state, const AfHeadingCoef *coef, doub
  * horizontal norm and dip alone) taken into psi_c and the reference; whether it was used. What the
  * guard judges and the heading follows is m through a low-pass (of tau_mag_guard, or unset of the
  * time guard_rate gives), which averages a fast magnetometer's noise (a field fixed in the earth
- * frame passes it unchanged); the start-up begins it at the sample. */
+ * frame passes it unchanged); the start-up begins it at the sample, and its running mean of the heading
+ * takes each sample as it comes. */
 static int field_sample(AfHeading *state, const AfHeadingCoef *coef, Quat q, Vec3 m)
 {
     double clip = coef->clip;
@@ -243,6 +244,7 @@ static int field_sample(AfHeading *state, const AfHeadingCoef *coef, Quat q, Vec
         state->steps = 1.0;
     double *f = state->m_low;
     f[0] += a_low * (m.x - f[0]), f[1] += a_low * (m.y - f[1]), f[2] += a_low * (m.z - f[2]);
+    Vec3 sample = m;
     m = (Vec3){f[0], f[1], f[2]};
     double horizontal = sqrt(m.x * m.x + m.y * m.y);
     if (horizontal == 0.0) /* a field with no heading */
@@ -265,9 +267,10 @@ static int field_sample(AfHeading *state, const AfHeadingCoef *coef, Quat q, Vec
         return 0;
     double h = atan2(m.x, m.y); /* the field's heading: psi - h the heading error (psi within [-pi, pi]) */
     field_noise(state, coef, h, gap, start);
-    if (start) { /* running means, every sample */
-        ok = 1;
-        state->psi_c += wrapped(h - state->psi_c) / state->seen;
+    if (start) { /* running means, every sample; psi_c's of the sample's heading, which a tilt still settling */
+        ok = 1;                                   /* leaves at once (in the low-pass it lingers) */
+        double h_sample = sample.x != 0.0 || sample.y != 0.0 ? atan2(sample.x, sample.y) : h;
+        state->psi_c += wrapped(h_sample - state->psi_c) / state->seen;
         state->ref_norm += (norm - state->ref_norm) / state->seen;
         state->ref_dip += (dip - state->ref_dip) / state->seen;
     } else if (ok) { /* first-order pulls over the time since the last field sample */
