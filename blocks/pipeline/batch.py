@@ -15,13 +15,14 @@ from attitude_fmu.blocks.methods.registry import METHODS
 from attitude_fmu.blocks.methods.registry import method as get_method
 from attitude_fmu.blocks.pipeline.causal import Pipeline, State, Step, at, configure, run
 from attitude_fmu.blocks.stages import heading as heading_stage
-from attitude_fmu.blocks.stages import heading_choice
+from attitude_fmu.blocks.stages import heading_choice, soft_iron
 from attitude_fmu.blocks.stages import scale_error
 from attitude_fmu.blocks.stages.delays import mag_delay
 from attitude_fmu.blocks.stages.gyro_offset import correct as correct_gyro
 from attitude_fmu.blocks.stages.gyro_offset import offset_estimate
 from attitude_fmu.blocks.stages.hard_iron import back_dated
 from attitude_fmu.blocks.stages.heading import smoothed_with_magnetometer
+from attitude_fmu.blocks.stages.soft_iron import SoftIron
 from attitude_fmu.blocks.stages.timing import carry_forward_rows, interval_ends, interval_means
 
 
@@ -40,6 +41,7 @@ class AttitudeEstimate:
     mag_offset: np.ndarray | None = None  # N×3, µT, hard-iron offset estimate (blocks.stages.hard_iron)
     mag_delay: np.ndarray | None = None  # N, s, the magnetometer's delay behind the gyro the heading allowed for
     mag_delay_source: str | None = None  # "given", "online" (blocks.stages.mag_delay) or "measured" (whole recording)
+    mag_soft_iron: SoftIron | None = None  # offline: the ellipsoid the field was turned onto a sphere by, if proven
     chosen: dict | None = None  # parameters chosen from the recording: {"scale_error": value[, "tau_heading": s]}
 
     @property
@@ -294,7 +296,8 @@ def smoothed(pipeline: Pipeline, step: Step, gyr, acc, mag, initial_gravity=None
 def _offline_heading(est: AttitudeEstimate, pipeline: Pipeline, mag, gyr, fs: float) -> None:
     """The heading stage smoothed over the whole recording, in place: the magnetometer's
     delay measured unless given, then once more with each hard-iron offset from where the
-    field changed, on the field freed of it."""
+    field changed, on the field freed of it; then, where the field the heading used proves an
+    ellipsoid (blocks.stages.soft_iron), once more on the field turned onto a sphere."""
     params = dict(pipeline.heading_params)
     est.mag_delay_source = _mag_delay_source(pipeline, offline=True)
     if est.mag_delay_source == "measured":
@@ -308,3 +311,8 @@ def _offline_heading(est: AttitudeEstimate, pipeline: Pipeline, mag, gyr, fs: fl
             params["mag_delay"] = max(mag_delay(gyr, freed, fs) or 0.0, 0.0)
         est.quat, est.mag_accepted, _, est.mag_delay = smoothed_with_magnetometer(quat, freed, fs,
                                                                                   {**params, "mag_cal_time": 0.0})
+        mag = freed
+    est.mag_soft_iron = soft_iron.fit(mag[est.mag_accepted], heading_stage.resolve(params)["mag_cal_spread"])
+    if est.mag_soft_iron is not None:
+        est.quat, est.mag_accepted, _, est.mag_delay = smoothed_with_magnetometer(
+            quat, est.mag_soft_iron.corrected(mag), fs, {**params, "mag_cal_time": 0.0})

@@ -537,6 +537,12 @@ def _estimate_one(args, path, out, prefix: str) -> None:
               f"{100 * result.mag_accepted[sampled].mean():.0f} %, hard-iron offset at the end "
               f"({', '.join(f'{v:.1f}' for v in result.mag_offset[-1])}) µT; {_mag_delay_text(result)}",
               file=sys.stderr)
+    if result.mag_soft_iron is not None:
+        fitted = result.mag_soft_iron
+        print(f"attitude: {prefix}soft iron taken: the field turned onto a sphere by an ellipsoid (centre "
+              f"{', '.join(f'{v:.1f}' for v in fitted.centre)} µT, which leaves "
+              f"{100 * fitted.variance / fitted.sphere_variance:.0f} % of the sphere's mean square distance)",
+              file=sys.stderr)
 
 
 def _mag_delay_text(result) -> str:
