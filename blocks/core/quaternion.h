@@ -9,6 +9,7 @@
 typedef struct { double w, x, y, z; } Quat;
 typedef struct { double x, y, z; } Vec3;
 
+#define AF_PI 3.14159265358979323846 /* rad */
 #define SERIES_ANGLE2 1e-2 /* (rad)^2: below it the half-angle series to theta^8 is exact to double precision */
 
 /* the quaternion a state array holds in q[0..3] */

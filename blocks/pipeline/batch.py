@@ -299,20 +299,21 @@ def _offline_heading(est: AttitudeEstimate, pipeline: Pipeline, mag, gyr, fs: fl
     field changed, on the field freed of it; then, where the field the heading used proves an
     ellipsoid (blocks.stages.soft_iron), once more on the field turned onto a sphere."""
     params = dict(pipeline.heading_params)
+    resolved = heading_stage.resolve(params)  # mag_cal_tol and mag_cal_spread (the delay is set below)
     est.mag_delay_source = _mag_delay_source(pipeline, offline=True)
     if est.mag_delay_source == "measured":
         params["mag_delay"] = max(mag_delay(gyr, mag, fs) or 0.0, 0.0)
     quat = est.quat
     est.quat, est.mag_accepted, est.mag_offset, est.mag_delay = smoothed_with_magnetometer(quat, mag, fs, params)
     if est.mag_offset.any():  # again, with each hard-iron offset from where the field changed
-        est.mag_offset = back_dated(mag, est.mag_offset, fs, heading_stage.resolve(params))
+        est.mag_offset = back_dated(mag, est.mag_offset, fs, resolved)
         freed = mag - est.mag_offset
         if est.mag_delay_source == "measured":  # the offset no longer hides the delay
             params["mag_delay"] = max(mag_delay(gyr, freed, fs) or 0.0, 0.0)
         est.quat, est.mag_accepted, _, est.mag_delay = smoothed_with_magnetometer(quat, freed, fs,
                                                                                   {**params, "mag_cal_time": 0.0})
         mag = freed
-    est.mag_soft_iron = soft_iron.fit(mag[est.mag_accepted], heading_stage.resolve(params)["mag_cal_spread"])
+    est.mag_soft_iron = soft_iron.fit(mag[est.mag_accepted], resolved["mag_cal_spread"])
     if est.mag_soft_iron is not None:
         est.quat, est.mag_accepted, _, est.mag_delay = smoothed_with_magnetometer(
             quat, est.mag_soft_iron.corrected(mag), fs, {**params, "mag_cal_time": 0.0})

@@ -103,16 +103,22 @@ def heading_system(dt: float, params=None, name: str = "heading"):
                                      rest=lambda u: resting(run, initial_state(), u, dt), rest_inputs=REST_INPUTS))
 
 
+def _run_arrays(quat, mag):
+    """(quat, mag) contiguous float arrays and the heading stage's outputs allocated for their N
+    rows: orientation N×4, accepted N, hard-iron offset N×3, delay N."""
+    quat = np.ascontiguousarray(quat, dtype=float)
+    n = len(quat)
+    outputs = (np.empty((n, 4)), np.empty(n, dtype=np.bool_), np.empty((n, 3)), np.empty(n))
+    return quat, np.ascontiguousarray(mag, dtype=float), outputs
+
+
 def with_magnetometer(quat, mag, fs: float, params=None):
     """(orientation with magnetometer heading N×4, accepted N, hard-iron offset N×3 in the
     field's unit, the magnetometer's delay allowed for N in s) for a whole recording: quat
     N×4 (sensor → earth, the attitude filter's), mag N×3 (a row with a NaN: no field sample)."""
-    quat = np.ascontiguousarray(quat, dtype=float)
-    n = len(quat)
-    out, accepted, offset, delay = np.empty((n, 4)), np.empty(n, dtype=np.bool_), np.empty((n, 3)), np.empty(n)
-    _core.heading_run(initial_state(), coefficients(resolve(params), 1.0 / fs), quat,
-                      np.ascontiguousarray(mag, dtype=float), out, accepted, offset, delay)
-    return out, accepted, offset, delay
+    quat, mag, outputs = _run_arrays(quat, mag)
+    _core.heading_run(initial_state(), coefficients(resolve(params), 1.0 / fs), quat, mag, *outputs)
+    return outputs
 
 
 def smoothed_with_magnetometer(quat, mag, fs: float, params=None):
@@ -121,9 +127,6 @@ def smoothed_with_magnetometer(quat, mag, fs: float, params=None):
     weighted by what each has seen (blocks/core/pipeline/offline.h: offline_heading); accepted:
     used by either pass; the hard-iron offset and delay the forward pass's. params must give
     mag_delay (s; ValueError otherwise): backward in time the field leads the gyro by it."""
-    quat = np.ascontiguousarray(quat, dtype=float)
-    n = len(quat)
-    out, accepted, offset, delay = np.empty((n, 4)), np.empty(n, dtype=np.bool_), np.empty((n, 3)), np.empty(n)
-    _core.heading_smooth(coefficients(resolve(params), 1.0 / fs), quat, np.ascontiguousarray(mag, dtype=float),
-                         out, accepted, offset, delay)
-    return out, accepted, offset, delay
+    quat, mag, outputs = _run_arrays(quat, mag)
+    _core.heading_smooth(coefficients(resolve(params), 1.0 / fs), quat, mag, *outputs)
+    return outputs

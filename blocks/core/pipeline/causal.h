@@ -17,11 +17,12 @@
 #include "af_params.h"
 #include "methods/registry.h"
 #include "params.h"
+#include "quaternion.h"
 #include "stages/gyro_offset.h"
 #include "stages/heading.h"
 
 /* beyond these no IMU measures (the widest MEMS ranges, per axis): a sample beyond them is not taken */
-#define MAX_GYR_RAD_S (4000.0 * (3.14159265358979323846 / 180.0)) /* math.radians(4000.0) */
+#define MAX_GYR_RAD_S (4000.0 * (AF_PI / 180.0)) /* math.radians(4000.0) */
 #define MAX_ACC_M_S2 (400.0 * 9.80665)
 
 /* Pipeline: a configuration of the stages, validated by causal_configure. */

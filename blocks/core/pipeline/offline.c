@@ -101,9 +101,9 @@ int offline_heading(const AfHeadingCoef *coef, size_t n, const double *quat, con
     AfHeading state;
     heading_initial_state(&state);
     heading_run(&state, coef, n, quat, mag, out, accepted, offset, delay);
-    size_t first = n; /* the forward pass's first used field sample */
-    for (size_t k = 0; k < n && first == n; k++)
-        first = accepted[k] ? k : n;
+    size_t first = 0; /* the forward pass's first used field sample (n: none) */
+    while (first < n && !accepted[first])
+        first++;
     AfHeadingCoef back = *coef;
     back.delay = -coef->delay;
     heading_initial_state(&state);
@@ -120,7 +120,7 @@ int offline_heading(const AfHeadingCoef *coef, size_t n, const double *quat, con
         double w_b = pass_weight(last < n ? (double)(last - k) : -1.0, coef);
         double psi = forward;
         if (w_b > 0.0)
-            psi += w_b / (w_f + w_b) * remainder(state.psi_c - forward, 2.0 * 3.14159265358979323846);
+            psi += w_b / (w_f + w_b) * remainder(state.psi_c - forward, 2.0 * AF_PI);
         quat_store(quat_multiply(rotvec_quat(0.0, 0.0, psi), quat_load(quat + 4 * k)), out + 4 * k);
         accepted[k] = (unsigned char)(accepted[k] | ok);
     }

@@ -5,8 +5,6 @@
 
 #define EXPLAINED 0.5 /* the fit's residual must be below this share of the field's own */
 
-static const double PI = 3.14159265358979323846;
-
 #define STATE_FIELD(name, dims) AF_FIELD(AfHardIron, name)
 const AfField HARD_IRON_STATE_FIELDS[] = {HARD_IRON_FIELDS(STATE_FIELD)};
 const size_t HARD_IRON_N_FIELDS = sizeof HARD_IRON_STATE_FIELDS / sizeof HARD_IRON_STATE_FIELDS[0];
@@ -85,7 +83,7 @@ static double spread2(const double s[15])
     double half_det = 0.5 * (a * (d * f - e * e) - b * (b * f - c * e) + c * (b * e - c * d));
     double bounded = half_det < -1.0 ? -1.0 : half_det;
     double angle = acos(1.0 < bounded ? 1.0 : bounded) / 3.0;
-    return at_least_0(mean + 2.0 * p * cos(angle + 2.0 * PI / 3.0));
+    return at_least_0(mean + 2.0 * p * cos(angle + 2.0 * AF_PI / 3.0));
 }
 
 /* Fit: the algebraic sphere fit of the sums, and the sphere about 0 (the field as it is), in

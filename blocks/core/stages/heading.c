@@ -8,8 +8,6 @@
 const AfField HEADING_STATE_FIELDS[] = {HEADING_FIELDS(STATE_FIELD)};
 const size_t HEADING_N_FIELDS = sizeof HEADING_STATE_FIELDS / sizeof HEADING_STATE_FIELDS[0];
 
-static const double PI = 3.14159265358979323846;
-
 int heading_coefficients(const double params[AF_N_PARAMS], double Ts, AfHeadingCoef *coef)
 {
     double q = 0.5 * params[AF_P_delta_n] * params[AF_P_delta_n];
@@ -71,7 +69,7 @@ static void restart(AfHeading *state, const AfHeadingCoef *coef, int afresh)
 /* wrapped: an angle (rad) within (-3 pi, 3 pi) brought within [-pi, pi] */
 static double wrapped(double a)
 {
-    return a > PI ? a - 2.0 * PI : a < -PI ? a + 2.0 * PI : a;
+    return a > AF_PI ? a - 2.0 * AF_PI : a < -AF_PI ? a + 2.0 * AF_PI : a;
 }
 
 /* second_difference: the |second difference| d2 (rad) of three block means into the measure at
@@ -87,7 +85,7 @@ static void second_difference(double measure[2], double d2, double a)
 /* the noise density (rad^2 s) a measure of mean |second difference| d2 (rad) over blocks of t s gives */
 static double density(double d2, double t)
 {
-    return (PI / 2.0) / 6.0 * d2 * d2 * t;
+    return (AF_PI / 2.0) / 6.0 * d2 * d2 * t;
 }
 
 /* drift_block: a block's mean field heading (unwrapped, rad) into the drift estimate; differences of
@@ -107,7 +105,7 @@ static void drift_block(AfHeading *state, const AfHeadingCoef *coef, double mean
     double dt = 0.5 * (steps + state->blk_last) * coef->mag_delay.Ts; /* from the last block's middle to this one's */
     state->blk_last = steps;
     if (state->blocks >= 2.0)
-        second_difference(state->d2, fabs(remainder(mean - 2.0 * prev[1] + prev[0], 2.0 * PI)), coef->a_block);
+        second_difference(state->d2, fabs(remainder(mean - 2.0 * prev[1] + prev[0], 2.0 * AF_PI)), coef->a_block);
     if (state->blocks >= 2.0 && !start) {
         double s = fmax(coef->r_drift, density(state->d2[0], coef->block_steps * coef->mag_delay.Ts));
         double r = s / (steps * coef->mag_delay.Ts);
@@ -115,7 +113,7 @@ static void drift_block(AfHeading *state, const AfHeadingCoef *coef, double mean
         P[0] += dt * (2.0 * P[1] + dt * P[2]) + coef->q_psi * dt;
         P[1] += dt * P[2];
         P[2] += coef->q_rate * dt;
-        double inv_s = 1.0 / (P[0] + r), e = remainder(mean - state->level, 2.0 * PI);
+        double inv_s = 1.0 / (P[0] + r), e = remainder(mean - state->level, 2.0 * AF_PI);
         double k0 = P[0] * inv_s, k1 = P[1] * inv_s, p0 = P[0], p1 = P[1];
         state->level += k0 * e;
         state->rate += k1 * e;
@@ -216,7 +214,7 @@ static double guard_rate(const AfHeading *state, const AfHeadingCoef *coef, doub
     double mean_square = 0.0;
     for (int i = 0; i < 3; i++)
         mean_square += state->noise_abs[i] * state->noise_abs[i];
-    double sigma2 = (PI / 2.0) / 6.0 * mean_square / (3.0 * count * count);
+    double sigma2 = (AF_PI / 2.0) / 6.0 * mean_square / (3.0 * count * count);
     double spacing = state->noise_span / (state->noise_n - 1.0);
     double tolerance = (coef->norm_tol < coef->dip_tol ? coef->norm_tol : coef->dip_tol) * norm;
     if (!(sigma2 > 0.0 && tolerance > 0.0 && spacing > 0.0)) /* a quiet field, no tolerance, or a state */
@@ -364,7 +362,7 @@ void heading_step(AfHeading *state, const AfHeadingCoef *coef, const double q_in
         }
     }
     quat_store(q, state->q_prev);
-    if (fabs(state->psi_c) > PI)
+    if (fabs(state->psi_c) > AF_PI)
         state->psi_c = atan2(sin(state->psi_c), cos(state->psi_c));
     quat_store(about_up(state->psi_c, q), out);
 }
