@@ -4,6 +4,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "filters/sensor_frame.h"
 #include "quaternion.h"
 
 /* the gyro sample that turns the frame from sample n - k to n - 1 - k in a pass backward in time, k = 0 ... n - 1:
@@ -12,19 +13,6 @@ static void time_reversed_sample(size_t n, const double *gyr, size_t k, double o
 {
     for (int i = 0; i < 3; i++)
         out[i] = k == 0 ? 0.0 : -gyr[3 * (n - k) + i];
-}
-
-/* q (sensor -> earth) turned by the smallest earth-frame rotation that takes the estimated up (gravity, sensor
- * coordinates) onto earth up: its heading kept */
-static void level_onto(const double q[4], const double gravity[3], double out[4])
-{
-    Quat rot = quat_normalized(quat_load(q));
-    double norm = sqrt(gravity[0] * gravity[0] + gravity[1] * gravity[1] + gravity[2] * gravity[2]);
-    Vec3 up = quat_rotate(rot, (Vec3){gravity[0] / norm, gravity[1] / norm, gravity[2] / norm});
-    double horizontal = hypot(up.x, up.y);
-    double angle = atan2(horizontal, up.z);
-    double scale = horizontal > 0.0 ? angle / horizontal : 0.0;
-    quat_store(quat_normalized(quat_multiply(rotvec_quat(up.y * scale, -up.x * scale, 0.0), rot)), out);
 }
 
 /* One pass of the stepper over n samples, forward (the rows as given) or backward in time (row k
@@ -73,11 +61,18 @@ void offline_smooth(const AfStepper *stepper, size_t n, const double *gyr, const
             omega[k] = fmin(omega[k], backward[k]);
         imposed = omega;
     }
-    pass(stepper, n, gyr, acc, 0, initial_gravity, imposed, NULL, gravity, quat);
+    pass(stepper, n, gyr, acc, 0, initial_gravity, imposed, NULL, gravity, NULL);
     memcpy(last, gravity + 3 * (n - 1), sizeof last);
     pass(stepper, n, gyr, gravity, 1, last, imposed, NULL, gravity, NULL);
-    for (size_t k = 0; k < n; k++)
-        level_onto(quat + 4 * k, gravity + 3 * k, quat + 4 * k);
+    /* the orientation: the gyro's, levelled onto the smoothed gravity at each row (as a stepper does onto its
+     * own estimate): the few large corrections of a pass's first rows in motion turn no heading into it */
+    Quat q = {1.0, 0.0, 0.0, 0.0};
+    const double Ts = stepper->Ts;
+    for (size_t k = 0; k < n; k++) {
+        const double *w = gyr + 3 * k, *g = gravity + 3 * k;
+        q = level_onto_gravity(q, rotvec_quat(w[0] * Ts, w[1] * Ts, w[2] * Ts), (Vec3){g[0], g[1], g[2]});
+        quat_store(q, quat + 4 * k);
+    }
 }
 
 /* the heading correction (rad) that turned q into out about earth up: psi of out (x) q^-1 = Rz(psi) */

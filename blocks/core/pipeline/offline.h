@@ -14,7 +14,8 @@
 /* The smoother over n >= 1 samples gyr, acc (n x 3): the stepper's method runs forward from
  * rest on initial_gravity (m/s^2, sensor coordinates, before the first sample), then backward
  * in time over the forward gravity estimate, from rest on its last row; gravity (n x 3) is the
- * backward estimate and quat (n x 4) the forward orientation levelled onto it (level_onto).
+ * backward estimate and quat (n x 4) the gyro's orientation from the identity, levelled onto it
+ * at each row (level_onto_gravity: the heading the gyro's).
  * wiener's local densities (KERNEL_WIENER_LOCAL) run both passes at the lower of the break
  * frequencies the densities give forward and backward in time (each pass from rest on its
  * first accelerometer row, the forward one on initial_gravity); omega: n values of scratch. */
