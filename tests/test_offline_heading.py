@@ -85,13 +85,13 @@ def test_the_smoothed_heading_refuses_what_it_cannot_run():
 def test_offline_9d_heading_is_ahead_of_the_forward_pass_on_the_scenarios(name):
     """On the results page's scenarios the offline 9D heading is ahead of online, and of what the
     forward pass alone gave (phone_flat 3.44°, robot_arm 0.128°, segment_40hz 2.81°, vqf's offline
-    2.50° there); on segment_40hz at or ahead of vqf's offline."""
+    2.50° there); on segment_40hz and robot_arm at or ahead of vqf's offline (robot_arm 0.056° against
+    0.026° while a motion's onset was averaged into the offline gyro offset as rest)."""
     before = {"phone_flat": 3.44, "robot_arm": 0.128, "segment_40hz": 2.81}[name]
     cells = score(name)
     offline, online = cells["heading 9D offline"], cells["heading 9D"]
     print(name, {k: round(v, 3) for k, v in offline.items()}, "online", round(online["ours"], 3))
     assert offline["ours"] < 0.9 * before
-    if name != "robot_arm":  # robot_arm: the 6D heading's drift (0.47°) leaves 0.056° against 0.049° online
-        assert offline["ours"] < online["ours"]
-    if name == "segment_40hz":
+    assert offline["ours"] < online["ours"]
+    if name != "phone_flat":
         assert offline["ours"] <= offline["vqf"]

@@ -221,6 +221,30 @@ def test_offline_offset_comes_from_the_whole_recording():
     assert error(est) < 0.6 * error(estimate(causal, acc, FS, offline=True, gyro_offset=False))
 
 
+def test_offline_a_slow_onset_of_motion_is_not_taken_for_rest():
+    """5 s at rest, then turns of 90° about the vertical of minimum jerk (1.2 s; rate 30·s²(1 − s)²·θ/T, which
+    starts too slowly to break the rest at once) between 0.5-s dwells, then 5 s at rest; a calibrated gyro
+    (0.004 °/s/√Hz) with a known offset, the accelerometer still. Forward in time the onset's first samples
+    count as rest and shift the vertical offset by 0.012 °/s; offline a rest's sample counts only where
+    the rest holds rest_time after it too, and the offset stays within 0.005 °/s of the truth over the motion."""
+    rng = np.random.default_rng(1)
+    s = np.arange(int(1.2 * FS)) / (1.2 * FS)
+    rate = math.radians(90.0) / 1.2 * 30.0 * s ** 2 * (1.0 - s) ** 2
+    dwell, rest = np.zeros(int(0.5 * FS)), np.zeros(int(5 * FS))
+    turn = np.concatenate([rest, *[piece for i in range(20) for piece in ((-1) ** i * rate, dwell)], rest])
+    n = len(turn)
+    offset = np.radians([0.03, -0.02, 0.05])
+    gyr = np.column_stack([np.zeros(n), np.zeros(n), turn]) + offset
+    gyr += rng.normal(0.0, math.radians(0.004) * math.sqrt(FS / 2), (n, 3))
+    acc = np.tile([0.0, 0.0, 9.81], (n, 1)) + rng.normal(0.0, 6e-4, (n, 3))
+    motion = slice(int(5 * FS), n - int(5 * FS))
+    errors = {offline: np.degrees(correct_gyro(gyr, acc, FS, offline=offline)[1] - offset)[motion, 2]
+              for offline in (False, True)}
+    print({offline: round(float(np.abs(e).max()), 4) for offline, e in errors.items()})
+    assert np.abs(errors[False]).max() > 0.008  # °/s: forward, the onset taken for rest
+    assert np.abs(errors[True]).max() < 0.005
+
+
 @pytest.mark.parametrize("profile", ["lever_arm", "offset_rotation"])
 def test_offset_tracking_does_not_take_centripetal_acceleration_for_an_offset(profile):
     """Steady or swinging rotation on an arm: the sensor-fixed centripetal acceleration turns

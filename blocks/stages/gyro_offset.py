@@ -105,20 +105,26 @@ def offset_estimate(gyr, acc, fs: float, params=None, offline: bool = False):
     recording: gyr N×3 rad/s, acc N×3 m/s², fs Hz. offline: the estimates of a forward and a
     backward pass in time (whose gyro is blocks.filters.sensor_frame.time_reversed, its offset
     the negative), each axis weighted by the inverse of its pass's variance: every sample's
-    offset from all rests and motion, of the variance v_f·v_b/(v_f + v_b)."""
+    offset from all rests and motion, of the variance v_f·v_b/(v_f + v_b); there a rest's
+    sample measures the offset only where the rest holds rest_time after it as well (the
+    detection backward in time), so that a motion's slow onset is not taken for rest."""
     gyr = np.ascontiguousarray(gyr, dtype=float)
     acc = np.ascontiguousarray(acc, dtype=float)
     coef = coefficients(resolve(params), 1.0 / fs)
 
-    def one_pass(g, a):
-        offset, variance = np.empty_like(g), np.empty_like(g)
-        _core.gyro_offset_run(initial_state(coef, g[0], a[0]), coef, g, a, offset, variance)
-        return offset, variance
+    def one_pass(g, a, allowed=None):
+        offset, variance, resting = np.empty_like(g), np.empty_like(g), np.empty(len(g), dtype=np.bool_)
+        _core.gyro_offset_run(initial_state(coef, g[0], a[0]), coef, g, a, offset, variance, allowed, resting)
+        return offset, variance, resting
 
-    offset, variance = one_pass(gyr, acc)
-    if offline:
-        back, back_variance = one_pass(time_reversed(gyr), np.ascontiguousarray(acc[::-1]))
-        weight = back_variance[::-1] / (variance + back_variance[::-1])
-        offset = weight * offset - (1.0 - weight) * back[::-1]
-        variance = weight * variance
-    return offset, variance
+    if not offline:
+        return one_pass(gyr, acc)[:2]
+    # a rest's sample measures the offset where the rest holds rest_time before and after it: a motion's onset,
+    # which the detection still takes for rest, is then no rest backward in time
+    backward = time_reversed(gyr), np.ascontiguousarray(acc[::-1])
+    resting_back = one_pass(*backward)[2]
+    offset, variance, resting = one_pass(gyr, acc, np.ascontiguousarray(resting_back[::-1]))
+    back, back_variance, _ = one_pass(*backward, np.ascontiguousarray(resting[::-1]))
+    weight = back_variance[::-1] / (variance + back_variance[::-1])
+    offset = weight * offset - (1.0 - weight) * back[::-1]
+    return offset, weight * variance

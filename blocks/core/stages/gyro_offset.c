@@ -200,8 +200,10 @@ static Quat unit(Quat q)
     return (Quat){q.w * k, q.x * k, q.y * k, q.z * k};
 }
 
-void gyro_offset_step(AfGyroOffset *state, const AfGyroOffsetCoef *coef, const double gyr[3], const double acc[3],
-                      double offset[3], double variance[3])
+/* gyro_offset_step, a rest's sample taken as a measurement of the offset only where allowed; whether the rest
+ * has held rest_time at the sample into *resting (NULL: not wanted) */
+static inline void step(AfGyroOffset *state, const AfGyroOffsetCoef *coef, const double gyr[3], const double acc[3],
+                        int allowed, double offset[3], double variance[3], unsigned char *resting)
 {
     double Ts = coef->Ts, V = coef->V;
     /* the inputs read and the offset estimate b and its covariance P updated in place: copies on the stack,
@@ -256,7 +258,10 @@ void gyro_offset_step(AfGyroOffset *state, const AfGyroOffsetCoef *coef, const d
         double p = P[4 * i] + V;
         P[4 * i] = coef->P0 < p ? coef->P0 : p;
     }
-    if (state->rest >= coef->rest_time) { /* each axis of the gyro sample measures b with variance r */
+    int rested = state->rest >= coef->rest_time;
+    if (resting != NULL)
+        *resting = (unsigned char)rested;
+    if (rested && allowed) { /* each axis of the gyro sample measures b with variance r */
         for (int i = 0; i < 3; i++) {
             double h[3] = {i == 0 ? 1.0 : 0.0, i == 1 ? 1.0 : 0.0, i == 2 ? 1.0 : 0.0};
             scalar_update(b, P, h, gyr[i], coef->r);
@@ -270,9 +275,17 @@ void gyro_offset_step(AfGyroOffset *state, const AfGyroOffsetCoef *coef, const d
     }
 }
 
+void gyro_offset_step(AfGyroOffset *state, const AfGyroOffsetCoef *coef, const double gyr[3], const double acc[3],
+                      double offset[3], double variance[3])
+{
+    step(state, coef, gyr, acc, 1, offset, variance, NULL);
+}
+
 void gyro_offset_run(AfGyroOffset *state, const AfGyroOffsetCoef *coef, size_t n, const double *gyr,
-                     const double *acc, double *offset, double *variance)
+                     const double *acc, const unsigned char *allowed, double *offset, double *variance,
+                     unsigned char *resting)
 {
     for (size_t k = 0; k < n; k++)
-        gyro_offset_step(state, coef, gyr + 3 * k, acc + 3 * k, offset + 3 * k, variance + 3 * k);
+        step(state, coef, gyr + 3 * k, acc + 3 * k, allowed == NULL || allowed[k], offset + 3 * k, variance + 3 * k,
+             resting != NULL ? resting + k : NULL);
 }

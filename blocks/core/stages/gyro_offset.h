@@ -52,8 +52,12 @@ void gyro_offset_initial_state(const AfGyroOffsetCoef *coef, const double gyr0[3
 void gyro_offset_step(AfGyroOffset *state, const AfGyroOffsetCoef *coef, const double gyr[3], const double acc[3],
                       double offset[3], double variance[3]);
 
-/* gyro_offset_step over n samples, rows of 3: gyr, acc in; offset, variance out. */
+/* gyro_offset_step over n samples, rows of 3: gyr, acc in; offset, variance out. allowed (n values; NULL:
+ * every sample): a sample at rest measures the offset only where allowed[k] is not 0 (elsewhere the tracking
+ * while moving runs); resting (n values; NULL: not written): 1 where the rest had held rest_time at sample k,
+ * else 0 (the rest detection alone: it does not depend on allowed or the estimate). */
 void gyro_offset_run(AfGyroOffset *state, const AfGyroOffsetCoef *coef, size_t n, const double *gyr,
-                     const double *acc, double *offset, double *variance);
+                     const double *acc, const unsigned char *allowed, double *offset, double *variance,
+                     unsigned char *resting);
 
 #endif
