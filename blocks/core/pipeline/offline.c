@@ -17,12 +17,12 @@ static void time_reversed_sample(size_t n, const double *gyr, size_t k, double o
 
 /* One pass of the stepper over n samples, forward (the rows as given) or backward in time (row k
  * of the pass is row n - 1 - k, turned by time_reversed_sample), from rest on start; the pass's
- * row k of the estimate into gravity and quat at row n - 1 - k when backward (each row of acc is
+ * row k of the gravity estimate into gravity at row n - 1 - k when backward (each row of acc is
  * read before it is written, so acc may be gravity). wiener's local densities: at the break
  * frequencies omega (rows as the pass's, NULL: the local ones), and where used is not NULL the
  * ones used into it (rows as the pass's). */
 static void pass(const AfStepper *s, size_t n, const double *gyr, const double *acc, int backward,
-                 const double start[3], const double *omega, double *used, double *gravity, double *quat)
+                 const double start[3], const double *omega, double *used, double *gravity)
 {
     double state[AF_STEPPER_STATE_MAX], g[3], q[4];
     stepper_initial_state(s, start, state);
@@ -40,8 +40,6 @@ static void pass(const AfStepper *s, size_t n, const double *gyr, const double *
             stepper_run(s, state, turn, acc + 3 * row, g, q);
         }
         memcpy(gravity + 3 * row, g, sizeof g);
-        if (quat != NULL)
-            memcpy(quat + 4 * row, q, sizeof q);
     }
 }
 
@@ -54,16 +52,16 @@ void offline_smooth(const AfStepper *stepper, size_t n, const double *gyr, const
         /* the break frequencies of the local densities forward, then the lower of those and the
          * backward ones; gravity and quat serve as scratch meanwhile */
         double *backward = quat; /* n values at least (n x 4) */
-        pass(stepper, n, gyr, acc, 0, initial_gravity, NULL, omega, gravity, NULL);
+        pass(stepper, n, gyr, acc, 0, initial_gravity, NULL, omega, gravity);
         memcpy(last, acc + 3 * (n - 1), sizeof last);
-        pass(stepper, n, gyr, acc, 1, last, NULL, backward, gravity, NULL);
+        pass(stepper, n, gyr, acc, 1, last, NULL, backward, gravity);
         for (size_t k = 0; k < n; k++)
             omega[k] = fmin(omega[k], backward[k]);
         imposed = omega;
     }
-    pass(stepper, n, gyr, acc, 0, initial_gravity, imposed, NULL, gravity, NULL);
+    pass(stepper, n, gyr, acc, 0, initial_gravity, imposed, NULL, gravity);
     memcpy(last, gravity + 3 * (n - 1), sizeof last);
-    pass(stepper, n, gyr, gravity, 1, last, imposed, NULL, gravity, NULL);
+    pass(stepper, n, gyr, gravity, 1, last, imposed, NULL, gravity);
     /* the orientation: the gyro's, levelled onto the smoothed gravity at each row (as a stepper does onto its
      * own estimate): the few large corrections of a pass's first rows in motion turn no heading into it */
     Quat q = {1.0, 0.0, 0.0, 0.0};
