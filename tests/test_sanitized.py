@@ -1,5 +1,5 @@
 """The C core, its Python extension and the native FMUs built with -fsanitize=address,undefined
-(CMake, through tests/native.py), run over the golden streams, the refusals and the simulation
+(CMake, through tests/native.py), run over the golden streams, the refusals, the simulation and the lever-arm fit
 again, and through the FMU-state, count and step refusals of tests/test_fmu_state.py: the same
 results, and no report of an out-of-bounds access, a use of freed or uninitialised memory or
 undefined behaviour; and diagrams exported by export_fmu, built with the sanitizers."""
@@ -25,7 +25,7 @@ def assert_clean(*test_files):
 
 def test_the_golden_streams_refusals_and_simulation_run_clean_on_the_sanitized_build():
     assert_clean("tests/test_golden.py", "tests/test_refusals.py", "tests/test_simulation.py",
-                 "tests/test_quaternion.py")
+                 "tests/test_quaternion.py", "tests/test_lever_arm.py")
 
 
 def test_the_fmu_state_refusals_run_clean_on_the_sanitized_build():

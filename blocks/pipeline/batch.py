@@ -15,13 +15,14 @@ from attitude_fmu.blocks.methods.registry import METHODS
 from attitude_fmu.blocks.methods.registry import method as get_method
 from attitude_fmu.blocks.pipeline.causal import Pipeline, State, Step, at, configure, run
 from attitude_fmu.blocks.stages import heading as heading_stage
-from attitude_fmu.blocks.stages import heading_choice, soft_iron
+from attitude_fmu.blocks.stages import heading_choice, lever_arm, soft_iron
 from attitude_fmu.blocks.stages import scale_error
 from attitude_fmu.blocks.stages.delays import mag_delay
 from attitude_fmu.blocks.stages.gyro_offset import correct as correct_gyro
 from attitude_fmu.blocks.stages.gyro_offset import offset_estimate
 from attitude_fmu.blocks.stages.hard_iron import back_dated
 from attitude_fmu.blocks.stages.heading import smoothed_with_magnetometer
+from attitude_fmu.blocks.stages.lever_arm import LeverArm
 from attitude_fmu.blocks.stages.soft_iron import SoftIron
 from attitude_fmu.blocks.stages.timing import carry_forward_rows, interval_ends, interval_means
 
@@ -42,6 +43,7 @@ class AttitudeEstimate:
     mag_delay: np.ndarray | None = None  # N, s, the magnetometer's delay behind the gyro the heading allowed for
     mag_delay_source: str | None = None  # "given", "online" (blocks.stages.mag_delay) or "measured" (whole recording)
     mag_soft_iron: SoftIron | None = None  # offline: the ellipsoid the field was turned onto a sphere by, if proven
+    lever_arm: LeverArm | None = None  # offline: the sensor's place from a fixed centre of rotation, if proven
     chosen: dict | None = None  # parameters chosen from the recording: {"scale_error": value[, "tau_heading": s]}
 
     @property
@@ -149,7 +151,10 @@ def estimate(
     offline: the batch-only additions (smoothed). The method's earth-frame filter runs
     forward, then backward over the forward estimate (for `wiener` the non-causal Wiener
     smoother, see blocks.filters.accuracy.smoother_mean_square_gravity_error); the gyro
-    offset comes from passes forward and backward in time; the magnetometer's delay is
+    offset comes from passes forward and backward in time; where the sensor turns about a
+    fixed centre (a robot's wrist, a pendulum) the accelerometer is freed of that rotation's
+    accelerations before the filter runs (blocks.stages.lever_arm; `lever_arm`, None where
+    not proven); the magnetometer's delay is
     measured from the whole recording (blocks.stages.delays.mag_delay; 0 where it cannot
     be or comes out negative) and each hard-iron offset the heading stage took or dropped
     holds from where the field changed (blocks.stages.hard_iron.back_dated); the heading
@@ -281,9 +286,12 @@ def smoothed(pipeline: Pipeline, step: Step, gyr, acc, mag, initial_gravity=None
     offset = None
     if pipeline.offset_params is not None:
         gyr, offset = correct_gyro(gyr, acc, fs, pipeline.offset_params, offline=True)
+    lever = lever_arm.fit(gyr, acc, fs)  # a fixed centre of rotation's accelerations, where proven
+    if lever is not None:
+        acc = lever.corrected(gyr, acc, fs)
     # the method forward, then backward over its estimate (blocks/core/pipeline/offline.h); wiener's
     # local densities: both passes at the lower of the break frequencies estimated forward and backward
-    est = AttitudeEstimate(np.empty((len(gyr), 3)), np.empty((len(gyr), 4)), offset)
+    est = AttitudeEstimate(np.empty((len(gyr), 3)), np.empty((len(gyr), 4)), offset, lever_arm=lever)
     _core.smooth(step.core, gyr, acc, None if initial_gravity is None else np.asarray(initial_gravity, dtype=float),
                  est.gravity, est.quat)
     if mag is not None:

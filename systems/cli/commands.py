@@ -537,6 +537,11 @@ def _estimate_one(args, path, out, prefix: str) -> None:
               f"{100 * result.mag_accepted[sampled].mean():.0f} %, hard-iron offset at the end "
               f"({', '.join(f'{v:.1f}' for v in result.mag_offset[-1])}) µT; {_mag_delay_text(result)}",
               file=sys.stderr)
+    if result.lever_arm is not None:
+        print(f"attitude: {prefix}lever arm taken: the sensor turns about a fixed centre from which it sits at "
+              f"({', '.join(f'{v:.3f}' for v in result.lever_arm.position)}) m; the accelerometer was freed of "
+              f"that turn's accelerations ({100 * result.lever_arm.explained:.1f} % of the specific force "
+              f"beside gravity)", file=sys.stderr)
     if result.mag_soft_iron is not None:
         fitted = result.mag_soft_iron
         print(f"attitude: {prefix}soft iron taken: the field turned onto a sphere by an ellipsoid (centre "

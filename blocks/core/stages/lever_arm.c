@@ -1,0 +1,96 @@
+/* lever_arm.c: the lever-arm fit's normal equations (see lever_arm.h). */
+#include "lever_arm.h"
+
+#include <string.h>
+
+#include "quaternion.h"
+
+/* A window's sums: of X^T.X, X^T.y, |y|^2 over its samples and of X and y, into the totals freed of the
+ * window's means: sum (x - mean)(x - mean)^T = sum x x^T - (sum x)(sum x)^T / count. */
+typedef struct {
+    double xx[9], xy[3], yy, x[9], y[3];
+    size_t count;
+} Sums;
+
+static void add_window(Sums *w, double normal[9], double moment[3], double *total)
+{
+    if (w->count == 0)
+        return;
+    double inv = 1.0 / (double)w->count;
+    for (int i = 0; i < 3; i++) {
+        for (int j = 0; j < 3; j++) {
+            double sx = 0.0;
+            for (int k = 0; k < 3; k++)
+                sx += w->x[3 * k + i] * w->x[3 * k + j];
+            normal[3 * i + j] += w->xx[3 * i + j] - sx * inv;
+        }
+        double sy = 0.0;
+        for (int k = 0; k < 3; k++)
+            sy += w->x[3 * k + i] * w->y[k];
+        moment[i] += w->xy[i] - sy * inv;
+    }
+    *total += w->yy - (w->y[0] * w->y[0] + w->y[1] * w->y[1] + w->y[2] * w->y[2]) * inv;
+    memset(w, 0, sizeof *w);
+}
+
+/* the rotation's terms at sample k of n: A (3 x 3, row-major) = [alpha]x + w w^T - |w|^2 I, A.r = alpha x r +
+ * w x (w x r), w the mean of gyr[k] and gyr[k + 1], alpha their difference over Ts (the last: gyr[k] alone) */
+static void rotation_terms(size_t n, size_t k, const double *gyr, double Ts, double A[9])
+{
+    const double *g = gyr + 3 * k, *next = k + 1 < n ? g + 3 : g;
+    double rate[3] = {0.5 * (g[0] + next[0]), 0.5 * (g[1] + next[1]), 0.5 * (g[2] + next[2])};
+    double turn[3] = {(next[0] - g[0]) / Ts, (next[1] - g[1]) / Ts, (next[2] - g[2]) / Ts};
+    double rate2 = rate[0] * rate[0] + rate[1] * rate[1] + rate[2] * rate[2];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            A[3 * i + j] = rate[i] * rate[j] - (i == j ? rate2 : 0.0);
+    A[1] -= turn[2], A[2] += turn[1], A[5] -= turn[0];
+    A[3] += turn[2], A[6] -= turn[1], A[7] += turn[0];
+}
+
+void lever_arm_removed(size_t n, const double *gyr, const double *acc, double Ts, const double r[3], double *out)
+{
+    for (size_t k = 0; k < n; k++) {
+        double A[9];
+        rotation_terms(n, k, gyr, Ts, A);
+        for (int i = 0; i < 3; i++)
+            out[3 * k + i] = acc[3 * k + i] - (A[3 * i] * r[0] + A[3 * i + 1] * r[1] + A[3 * i + 2] * r[2]);
+    }
+}
+
+void lever_arm_sums(size_t n, const double *gyr, const double *acc, double Ts, size_t window, double normal[9],
+                    double moment[3], double *total)
+{
+    memset(normal, 0, 9 * sizeof *normal);
+    memset(moment, 0, 3 * sizeof *moment);
+    *total = 0.0;
+    Sums w;
+    memset(&w, 0, sizeof w);
+    Quat q = {1.0, 0.0, 0.0, 0.0};
+    for (size_t k = 0; k < n; k++) {
+        const double *g = gyr + 3 * k, *a = acc + 3 * k;
+        q = quat_normalized(quat_multiply(q, rotvec_quat(g[0] * Ts, g[1] * Ts, g[2] * Ts)));
+        double R[9], A[9], X[9], y[3];
+        quat_matrix(q, R);
+        rotation_terms(n, k, gyr, Ts, A);
+        for (int i = 0; i < 3; i++) {
+            y[i] = R[3 * i] * a[0] + R[3 * i + 1] * a[1] + R[3 * i + 2] * a[2];
+            for (int j = 0; j < 3; j++)
+                X[3 * i + j] = R[3 * i] * A[j] + R[3 * i + 1] * A[3 + j] + R[3 * i + 2] * A[6 + j];
+        }
+        for (int i = 0; i < 3; i++) {
+            for (int j = 0; j < 3; j++)
+                w.xx[3 * i + j] += X[i] * X[j] + X[3 + i] * X[3 + j] + X[6 + i] * X[6 + j];
+            w.xy[i] += X[i] * y[0] + X[3 + i] * y[1] + X[6 + i] * y[2];
+        }
+        for (int i = 0; i < 9; i++)
+            w.x[i] += X[i];
+        for (int i = 0; i < 3; i++) {
+            w.y[i] += y[i];
+            w.yy += y[i] * y[i];
+        }
+        if (++w.count == window)
+            add_window(&w, normal, moment, total);
+    }
+    add_window(&w, normal, moment, total);
+}
