@@ -18,12 +18,13 @@ G = 9.81  # m/s²
 ARM = np.array([0.0, 0.05, -0.4])  # m: the sensor from the pivot, sensor coordinates (x along the pivot's axis)
 
 
-def _pendulum(duration: float = 120.0, pivot_shake: float = 0.0, seed: int = 0):
+def _pendulum(duration: float = 120.0, pivot_shake: float = 0.0, seed: int = 0, fs: float = FS,
+              gyro_noise: float = 0.01):
     """(gyr, acc, gravity in sensor coordinates) of a pendulum swinging about x, θ(t) = 0.6·sin(2.1·t) +
-    0.3·sin(3.7·t) rad, at FS with white noise (gyro 0.01 °/s/√Hz, accelerometer 0.01 m/s² per sample);
-    pivot_shake (m/s²): the pivot's own acceleration, three sines in the earth frame."""
+    0.3·sin(3.7·t) rad, at fs (Hz) with white noise (gyro gyro_noise °/s/√Hz, accelerometer 0.01 m/s² per
+    sample); pivot_shake (m/s²): the pivot's own acceleration, three sines in the earth frame."""
     rng = np.random.default_rng(seed)
-    t = np.arange(round(duration * FS)) / FS
+    t = np.arange(round(duration * fs)) / fs
 
     def angle(tt):
         return 0.6 * np.sin(2.1 * tt) + 0.3 * np.sin(3.7 * tt)
@@ -36,8 +37,8 @@ def _pendulum(duration: float = 120.0, pivot_shake: float = 0.0, seed: int = 0):
     gravity = R.inv().apply([0.0, 0.0, G])
     shake = pivot_shake * np.column_stack([np.sin(1.3 * t), np.sin(2.9 * t + 1.0), np.sin(0.7 * t + 2.0)])
     acc = gravity + np.cross(a, ARM) + np.cross(w, np.cross(w, ARM)) + R.inv().apply(shake)
-    gyr = np.column_stack([(angle(t) - angle(t - 1.0 / FS)) * FS, zero, zero])  # the interval means, exactly
-    gyr += rng.normal(0.0, math.radians(0.01) * math.sqrt(FS / 2.0), gyr.shape)
+    gyr = np.column_stack([(angle(t) - angle(t - 1.0 / fs)) * fs, zero, zero])  # the interval means, exactly
+    gyr += rng.normal(0.0, math.radians(gyro_noise) * math.sqrt(fs / 2.0), gyr.shape)
     return gyr, acc + rng.normal(0.0, 0.01, acc.shape), gravity
 
 
@@ -57,6 +58,18 @@ def test_a_pendulum_s_arm_is_found_and_its_accelerations_removed():
 
     swing, left = rms_over(acc - gravity), rms_over(found.corrected(gyr, acc, FS) - gravity)
     assert swing > 1.0 and left < 0.03 * swing
+
+
+@pytest.mark.parametrize("fs", [400.0, 1000.0])
+def test_a_fast_sampled_pendulum_with_a_consumer_gyro_is_found_as_well(fs):
+    """At 400 Hz and 1 kHz with a consumer gyro's noise (0.01 °/s/√Hz): ω and α from the gyro's means over
+    10 ms either side of a sample, not one sample's difference, whose noise would outweigh the swing's α
+    (over one sample the fit explains 81 % at 400 Hz and 21 % at 1 kHz, and finds 0.81 and 0.21 of the
+    arm: nothing is taken). The arm within 3 mm."""
+    gyr, acc, _ = _pendulum(fs=fs)
+    found = lever_arm.fit(gyr, acc, fs)
+    assert found is not None and found.explained > 0.95
+    assert np.abs(found.position[1:] - ARM[1:]).max() < 0.003
 
 
 def test_a_pivot_that_moves_is_not_taken_for_a_fixed_centre():
@@ -109,20 +122,24 @@ def test_attitude_estimate_offline_says_what_it_took(tmp_path, capsys):
 
 def test_the_core_refuses_what_it_cannot_fit():
     """The C core's entry points check their inputs before use: rows that disagree, no row, a sample time
-    that is no positive number, a window of no sample, an output of another length."""
+    that is no positive number, a span or a window of no sample, an output of another length."""
     from attitude_fmu import _core
 
     gyr, acc = np.zeros((4, 3)), np.tile([0.0, 0.0, G], (4, 1))
     with pytest.raises(ValueError, match="acc"):
-        _core.lever_arm_sums(gyr, acc[:3], 0.01, 2)
+        _core.lever_arm_sums(gyr, acc[:3], 0.01, 1, 2)
     with pytest.raises(ValueError, match="a sample or more"):
-        _core.lever_arm_sums(gyr[:0], acc[:0], 0.01, 2)
+        _core.lever_arm_sums(gyr[:0], acc[:0], 0.01, 1, 2)
     for Ts in (0.0, -0.01, math.nan, math.inf):
         with pytest.raises(ValueError, match="Ts must be"):
-            _core.lever_arm_sums(gyr, acc, Ts, 2)
+            _core.lever_arm_sums(gyr, acc, Ts, 1, 2)
         with pytest.raises(ValueError, match="Ts must be"):
-            _core.lever_arm_removed(gyr, acc, Ts, np.zeros(3), np.empty((4, 3)))
+            _core.lever_arm_removed(gyr, acc, Ts, 1, np.zeros(3), np.empty((4, 3)))
     with pytest.raises(ValueError, match="window"):
-        _core.lever_arm_sums(gyr, acc, 0.01, 0)
+        _core.lever_arm_sums(gyr, acc, 0.01, 1, 0)
+    with pytest.raises(ValueError, match="span"):
+        _core.lever_arm_sums(gyr, acc, 0.01, 0, 2)
+    with pytest.raises(ValueError, match="span"):
+        _core.lever_arm_removed(gyr, acc, 0.01, 0, np.zeros(3), np.empty((4, 3)))
     with pytest.raises(ValueError, match="out"):
-        _core.lever_arm_removed(gyr, acc, 0.01, np.zeros(3), np.empty((3, 3)))
+        _core.lever_arm_removed(gyr, acc, 0.01, 1, np.zeros(3), np.empty((3, 3)))

@@ -10,12 +10,14 @@ Over the whole recording r is fitted by least squares to the specific force turn
 frame the gyro integrates (where gravity stands still): in windows of WINDOW_S their mean is
 removed (gravity, and the slow turn the gyro's residual drift gives it), and what is left,
 R·a, is regressed on R·A, A·r = α×r + ω×(ω×r) (ω and α at each accelerometer sample from the
-gyro's interval means either side of it). No filter runs for it: one pass of the gyro's
+gyro's mean rates over SPAN_S either side of it: the gyro's noise differenced over one sample at
+1 kHz would outweigh a pendulum's α, and bias the fit toward no arm; over 10 ms it is what it is
+at 100 Hz). No filter runs for it: one pass of the gyro's
 integration and the sums, in the C core (blocks/core/stages/lever_arm.h), then a 3 × 3 system.
 
 It is taken only where it is proven: where the fit explains at least EXPLAINED_MIN of what
 the windows leave of the specific force, rotation about a fixed centre is then nearly all the
-motion (0.997 on the robot_arm scenario; 0.07–0.75 on BROAD's ten handheld trials, 0.00 on
+motion (0.997 on the robot_arm scenario; 0.07–0.76 on BROAD's ten handheld trials, 0.00–0.02 on
 simulated human motion with a lever arm and its own translation, where the centre moves: a
 fit there removes some accelerations and adds others). The accelerometer is then freed of
 A·r before the offline smoother runs; along a single axis of rotation no acceleration shows
@@ -30,6 +32,7 @@ import numpy as np
 from attitude_fmu import _core
 
 WINDOW_S = 10.0  # s: windows whose mean specific force (gravity, and the gyro's drift under it) is removed
+SPAN_S = 0.01  # s: ω and α from the gyro's means over this either side of a sample (one sample at 100 Hz)
 EXPLAINED_MIN = 0.9  # taken where the fit explains at least this share of the specific force the windows leave
 LEFT_MIN = 1e-3  # m/s² RMS: the windows leaving less (a motion in closed form, no noise), there is nothing to remove
 
@@ -43,12 +46,16 @@ class LeverArm:
     explained: float
 
     def corrected(self, gyr, acc, fs: float) -> np.ndarray:
-        """acc (N×3, m/s², at each sample) freed of α×r + ω×(ω×r), gyr (N×3, rad/s, each the mean
-        over the sample time before it) at fs Hz."""
+        """acc (N×3, m/s², at each sample) freed of α×r + ω×(ω×r) as fit takes them, gyr (N×3,
+        rad/s, each the mean over the sample time before it) at fs Hz."""
         gyr, acc = (np.ascontiguousarray(a, dtype=float) for a in (gyr, acc))
         out = np.empty_like(acc)
-        _core.lever_arm_removed(gyr, acc, 1.0 / fs, self.position, out)
+        _core.lever_arm_removed(gyr, acc, 1.0 / fs, _span(fs), self.position, out)
         return out
+
+
+def _span(fs: float) -> int:
+    return max(1, round(SPAN_S * fs))
 
 
 def fit(gyr, acc, fs: float) -> LeverArm | None:
@@ -59,7 +66,7 @@ def fit(gyr, acc, fs: float) -> LeverArm | None:
     n = len(gyr)
     if n < 2:
         return None
-    normal, moment, total = _core.lever_arm_sums(gyr, acc, 1.0 / fs, max(2, round(WINDOW_S * fs)))
+    normal, moment, total = _core.lever_arm_sums(gyr, acc, 1.0 / fs, _span(fs), max(2, round(WINDOW_S * fs)))
     normal = normal.reshape(3, 3)
     if total <= n * LEFT_MIN**2:
         return None

@@ -338,31 +338,35 @@ void bind_stages(nb::module_ &m)
                                    std::to_string(horizon)).c_str());
         return n;
     };
-    m.def("lever_arm_sums", [](const Rows3 &gyr, const Rows3 &acc, double Ts, size_t window) {
+    m.def("lever_arm_sums", [](const Rows3 &gyr, const Rows3 &acc, double Ts, size_t span, size_t window) {
         size_t n = gyr.shape(0);
         check_rows(acc.shape(0), n, "acc");
         if (n < 1) throw nb::value_error("the lever-arm fit needs a sample or more");
         if (!(std::isfinite(Ts) && Ts > 0.0)) throw nb::value_error("Ts must be a finite positive number of seconds");
+        if (span < 1) throw nb::value_error("span must be 1 sample or more");
         if (window < 1) throw nb::value_error("window must be 1 sample or more");
         auto normal = new_vector(9), moment = new_vector(3);
         double total;
         {
             nb::gil_scoped_release unlocked;
-            lever_arm_sums(n, gyr.data(), acc.data(), Ts, window, normal.data(), moment.data(), &total);
+            lever_arm_sums(n, gyr.data(), acc.data(), Ts, span, window, normal.data(), moment.data(), &total);
         }
         return nb::make_tuple(normal, moment, total);
-    }, nb::arg("gyr"), nb::arg("acc"), nb::arg("Ts"), nb::arg("window"),
+    }, nb::arg("gyr"), nb::arg("acc"), nb::arg("Ts"), nb::arg("span"), nb::arg("window"),
           "(normal (9, X^T.X row-major), moment (3, X^T.y), total (sum |y|^2)) of the lever-arm fit y = X.r over\n"
-          "gyr (N×3, rad/s, over Ts s each) and acc (N×3, m/s²), y and X freed of their means in consecutive\n"
-          "windows of `window` samples (blocks/core/stages/lever_arm.h).");
-    m.def("lever_arm_removed", [](const Rows3 &gyr, const Rows3 &acc, double Ts, const Three &r, Rows3 out) {
+          "gyr (N×3, rad/s, over Ts s each) and acc (N×3, m/s²), ω and α from the gyro's means over `span` samples\n"
+          "either side of each, y and X freed of their means in consecutive windows of `window` samples\n"
+          "(blocks/core/stages/lever_arm.h).");
+    m.def("lever_arm_removed", [](const Rows3 &gyr, const Rows3 &acc, double Ts, size_t span, const Three &r,
+                                  Rows3 out) {
         size_t n = gyr.shape(0);
         check_rows(acc.shape(0), n, "acc");
         check_rows(out.shape(0), n, "out");
         if (!(std::isfinite(Ts) && Ts > 0.0)) throw nb::value_error("Ts must be a finite positive number of seconds");
+        if (span < 1) throw nb::value_error("span must be 1 sample or more");
         nb::gil_scoped_release unlocked;
-        lever_arm_removed(n, gyr.data(), acc.data(), Ts, r.data(), out.data());
-    }, nb::arg("gyr"), nb::arg("acc"), nb::arg("Ts"), nb::arg("r"), nb::arg("out").noconvert(),
+        lever_arm_removed(n, gyr.data(), acc.data(), Ts, span, r.data(), out.data());
+    }, nb::arg("gyr"), nb::arg("acc"), nb::arg("Ts"), nb::arg("span"), nb::arg("r"), nb::arg("out").noconvert(),
           "out (N×3, m/s²) = acc less α×r + ω×(ω×r) for r (3, m) as lever_arm_sums takes them\n"
           "(blocks/core/stages/lever_arm.h).");
     m.def("prediction_error", [check_prediction](const Rows3 &gyr, const Rows3 &acc, const Rows3 &gravity, double Ts,

@@ -34,12 +34,22 @@ static void add_window(Sums *w, double normal[9], double moment[3], double *tota
 }
 
 /* the rotation's terms at sample k of n: A (3 x 3, row-major) = [alpha]x + w w^T - |w|^2 I, A.r = alpha x r +
- * w x (w x r), w the mean of gyr[k] and gyr[k + 1], alpha their difference over Ts (the last: gyr[k] alone) */
-static void rotation_terms(size_t n, size_t k, const double *gyr, double Ts, double A[9])
+ * w x (w x r); the gyro's mean rates over the span samples before t_k (gyr[k - span + 1 .. k]) and the span
+ * after (gyr[k + 1 .. k + span]), rows beyond the recording its first or last: w their mean, alpha their
+ * difference over span Ts */
+static void rotation_terms(size_t n, size_t k, const double *gyr, double Ts, size_t span, double A[9])
 {
-    const double *g = gyr + 3 * k, *next = k + 1 < n ? g + 3 : g;
-    double rate[3] = {0.5 * (g[0] + next[0]), 0.5 * (g[1] + next[1]), 0.5 * (g[2] + next[2])};
-    double turn[3] = {(next[0] - g[0]) / Ts, (next[1] - g[1]) / Ts, (next[2] - g[2]) / Ts};
+    double before[3] = {0.0, 0.0, 0.0}, after[3] = {0.0, 0.0, 0.0};
+    for (size_t j = 0; j < span; j++) {
+        const double *b = gyr + 3 * (k >= j ? k - j : 0), *a = gyr + 3 * (k + 1 + j < n ? k + 1 + j : n - 1);
+        for (int i = 0; i < 3; i++)
+            before[i] += b[i], after[i] += a[i];
+    }
+    double rate[3], turn[3];
+    for (int i = 0; i < 3; i++) {
+        rate[i] = 0.5 * (before[i] + after[i]) / (double)span;
+        turn[i] = (after[i] - before[i]) / ((double)span * (double)span * Ts);
+    }
     double rate2 = rate[0] * rate[0] + rate[1] * rate[1] + rate[2] * rate[2];
     for (int i = 0; i < 3; i++)
         for (int j = 0; j < 3; j++)
@@ -48,18 +58,19 @@ static void rotation_terms(size_t n, size_t k, const double *gyr, double Ts, dou
     A[3] += turn[2], A[6] -= turn[1], A[7] += turn[0];
 }
 
-void lever_arm_removed(size_t n, const double *gyr, const double *acc, double Ts, const double r[3], double *out)
+void lever_arm_removed(size_t n, const double *gyr, const double *acc, double Ts, size_t span, const double r[3],
+                       double *out)
 {
     for (size_t k = 0; k < n; k++) {
         double A[9];
-        rotation_terms(n, k, gyr, Ts, A);
+        rotation_terms(n, k, gyr, Ts, span, A);
         for (int i = 0; i < 3; i++)
             out[3 * k + i] = acc[3 * k + i] - (A[3 * i] * r[0] + A[3 * i + 1] * r[1] + A[3 * i + 2] * r[2]);
     }
 }
 
-void lever_arm_sums(size_t n, const double *gyr, const double *acc, double Ts, size_t window, double normal[9],
-                    double moment[3], double *total)
+void lever_arm_sums(size_t n, const double *gyr, const double *acc, double Ts, size_t span, size_t window,
+                    double normal[9], double moment[3], double *total)
 {
     memset(normal, 0, 9 * sizeof *normal);
     memset(moment, 0, 3 * sizeof *moment);
@@ -72,7 +83,7 @@ void lever_arm_sums(size_t n, const double *gyr, const double *acc, double Ts, s
         q = quat_normalized(quat_multiply(q, rotvec_quat(g[0] * Ts, g[1] * Ts, g[2] * Ts)));
         double R[9], A[9], X[9], y[3];
         quat_matrix(q, R);
-        rotation_terms(n, k, gyr, Ts, A);
+        rotation_terms(n, k, gyr, Ts, span, A);
         for (int i = 0; i < 3; i++) {
             y[i] = R[3 * i] * a[0] + R[3 * i + 1] * a[1] + R[3 * i + 2] * a[2];
             for (int j = 0; j < 3; j++)
