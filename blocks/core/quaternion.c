@@ -16,8 +16,7 @@ void integrate_rates(size_t n, const double *gyr, double Ts, double *quat)
 {
     Quat q = {1.0, 0.0, 0.0, 0.0};
     for (size_t k = 0; k < n; k++) {
-        const double *w = gyr + 3 * k;
-        q = quat_normalized(quat_multiply(q, rotvec_quat(w[0] * Ts, w[1] * Ts, w[2] * Ts)));
+        q = quat_turned(q, gyr + 3 * k, Ts);
         quat_store(q, quat + 4 * k);
     }
 }

@@ -98,6 +98,13 @@ static inline Quat quat_normalized(Quat q)
     return (Quat){q.w * inv, q.x * inv, q.y * inv, q.z * inv};
 }
 
+/* q turned by the mean rate w (rad/s, 3, sensor coordinates) over Ts s, normalised: one step of the gyro's
+ * integration */
+static inline Quat quat_turned(Quat q, const double w[3], double Ts)
+{
+    return quat_normalized(quat_multiply(q, rotvec_quat(w[0] * Ts, w[1] * Ts, w[2] * Ts)));
+}
+
 /* smallest rotation of u (length norm > 0) onto +z, unnormalised: w = norm + u.z; upside down (u along -z),
  * the half turn about x */
 static inline Quat level_quat(Vec3 u, double norm)

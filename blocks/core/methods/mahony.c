@@ -52,7 +52,7 @@ Vec3 mahony_step(MahonyState *state, double k_P, double k_I, double Ts, const do
     Vec3 v_hat = up_in_sensor(q);
     double a0 = acc[0], a1 = acc[1], a2 = acc[2];
     double norm = sqrt(a0 * a0 + a1 * a1 + a2 * a2);
-    double e0 = 0.0, e1 = 0.0, e2 = 0.0, w0, w1, w2;
+    double e0 = 0.0, e1 = 0.0, e2 = 0.0;
     if (norm > 0.0) {
         double v0 = a0 / norm, v1 = a1 / norm, v2 = a2 / norm;
         e0 = v1 * v_hat.z - v2 * v_hat.y;
@@ -62,10 +62,8 @@ Vec3 mahony_step(MahonyState *state, double k_P, double k_I, double Ts, const do
     state->b.x -= k_I * e0 * Ts;
     state->b.y -= k_I * e1 * Ts;
     state->b.z -= k_I * e2 * Ts;
-    w0 = gyr[0] - state->b.x + k_P * e0;
-    w1 = gyr[1] - state->b.y + k_P * e1;
-    w2 = gyr[2] - state->b.z + k_P * e2;
-    state->q = quat_normalized(quat_multiply(q, rotvec_quat(w0 * Ts, w1 * Ts, w2 * Ts)));
+    double w[3] = {gyr[0] - state->b.x + k_P * e0, gyr[1] - state->b.y + k_P * e1, gyr[2] - state->b.z + k_P * e2};
+    state->q = quat_turned(q, w, Ts);
     return up_in_sensor(state->q);
 }
 

@@ -80,7 +80,7 @@ void lever_arm_sums(size_t n, const double *gyr, const double *acc, double Ts, s
     Quat q = {1.0, 0.0, 0.0, 0.0};
     for (size_t k = 0; k < n; k++) {
         const double *g = gyr + 3 * k, *a = acc + 3 * k;
-        q = quat_normalized(quat_multiply(q, rotvec_quat(g[0] * Ts, g[1] * Ts, g[2] * Ts)));
+        q = quat_turned(q, g, Ts);
         double R[9], A[9], X[9], y[3];
         quat_matrix(q, R);
         rotation_terms(n, k, gyr, Ts, span, A);

@@ -12,7 +12,7 @@ size_t prediction_errors_of(size_t count, size_t n, const double *gyr, const dou
     size_t blocks = 0, counted = 0, per = (n - m + block - 1) / block;
     for (size_t k = 0; k < n; k++) {
         const double *w = gyr + 3 * k, *a = acc + 3 * k;
-        q = quat_normalized(quat_multiply(q, rotvec_quat(w[0] * Ts, w[1] * Ts, w[2] * Ts)));
+        q = quat_turned(q, w, Ts);
         Vec3 y = quat_rotate(q, (Vec3){a[0], a[1], a[2]});
         int last = k >= m && (++counted == block || k == n - 1);
         for (size_t c = 0; c < count; c++) {
