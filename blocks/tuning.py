@@ -115,7 +115,8 @@ GYRO_OFFSET = (
     Param("rest_gyr", math.radians(2.0), "rad/s",
           "largest deviation of the gyro (through tau_short) from its low-pass at rest; at least "
           f"{REST_NOISE_SIGMAS:g} times delta_n's noise through tau_short", **RATE_RAD_S),
-    Param("rest_gyr_abs", math.radians(5.0), "rad/s", "largest low-passed gyro norm at rest (offset included)",
+    Param("rest_gyr_abs", math.radians(10.0), "rad/s", "largest low-passed gyro norm at rest (offset included): "
+          "a raw MEMS gyro's zero-rate offset, ±5 °/s per axis in consumer datasheets, is 8.7 °/s at most",
           **RATE_RAD_S),
     Param("rest_acc", 0.5, "m/s²",
           "largest deviation of the accelerometer (through tau_short) from its low-pass at rest",

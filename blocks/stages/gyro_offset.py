@@ -104,13 +104,18 @@ def offset_estimate(gyr, acc, fs: float, params=None, offline: bool = False):
     """(offset estimate N×3 rad/s, its variance N×3 (rad/s)², per axis) over a whole
     recording: gyr N×3 rad/s, acc N×3 m/s², fs Hz. offline: the estimates of a forward and a
     backward pass in time (whose gyro is blocks.filters.sensor_frame.time_reversed, its offset
-    the negative), each axis weighted by the inverse of its pass's variance: every sample's
-    offset from all rests and motion, of the variance v_f·v_b/(v_f + v_b); there a rest's
-    sample measures the offset only where the rest holds rest_time after it as well (the
-    detection backward in time), so that a motion's slow onset is not taken for rest."""
+    the negative) combined per axis as two independent measurements of one offset that share
+    the prior (0 with variance sigma_init²), which is counted once: information
+    1/v = 1/v_f + 1/v_b − 1/sigma_init², offset v·(x_f/v_f + x_b/v_b). A pass that learnt
+    nothing of an axis (a vertical axis never at rest in its direction of time) then leaves
+    it to the other, where an average by inverse variances pulled it back towards 0.
+    There a rest's sample measures the offset only where the rest holds rest_time after it as
+    well (the detection backward in time), so that a motion's slow onset is not taken for
+    rest."""
     gyr = np.ascontiguousarray(gyr, dtype=float)
     acc = np.ascontiguousarray(acc, dtype=float)
-    coef = coefficients(resolve(params), 1.0 / fs)
+    resolved = resolve(params)
+    coef = coefficients(resolved, 1.0 / fs)
 
     def one_pass(g, a, allowed=None):
         offset, variance, resting = np.empty_like(g), np.empty_like(g), np.empty(len(g), dtype=np.bool_)
@@ -125,6 +130,7 @@ def offset_estimate(gyr, acc, fs: float, params=None, offline: bool = False):
     resting_back = one_pass(*backward)[2]
     offset, variance, resting = one_pass(gyr, acc, np.ascontiguousarray(resting_back[::-1]))
     back, back_variance, _ = one_pass(*backward, np.ascontiguousarray(resting[::-1]))
-    weight = back_variance[::-1] / (variance + back_variance[::-1])
-    offset = weight * offset - (1.0 - weight) * back[::-1]
-    return offset, weight * variance
+    forward_info, back_info = 1.0 / variance, 1.0 / back_variance[::-1]
+    # each pass's variance is at most sigma_init² (its forgetting stops there), so the sum stays >= 1/sigma_init²
+    combined = 1.0 / (forward_info + back_info - 1.0 / resolved["sigma_init"] ** 2)
+    return combined * (forward_info * offset - back_info * back[::-1]), combined
