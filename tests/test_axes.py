@@ -4,8 +4,10 @@ import math
 
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
 from attitude_fmu.systems.cli.commands import main
+from attitude_fmu.systems.recordings import axes
 from attitude_fmu.systems.recordings.axes import MAPS, axes_text, parse_axes
 from attitude_fmu.systems.recordings.reading import read_recording
 from attitude_fmu.systems.recordings.recording import IMU_COLUMNS, MAG_COLUMNS
@@ -106,3 +108,38 @@ def test_a_bad_axis_map_is_refused_before_any_work(tmp_path, human, capsys):
         main(["estimate", str(tmp_path / "in.csv"), "--out", str(tmp_path / "o.csv"), "--acc-axes", "x,x,z"])
     assert "names x, y and z once each" in capsys.readouterr().err
     assert not (tmp_path / "o.csv").exists()
+
+
+def test_a_join_between_stretches_is_left_out():
+    """A pair of windows across a join (mismatches' joins) is left out: a vector that stays put in
+    each of two stretches but jumps between them (as the gyro integrated through a join cannot
+    follow) mismatches nothing with the join given, and without it the jump's square, 2g², is
+    shared among the pairs."""
+    fs, g = 10.0, 9.81
+    window = round(axes.WINDOW_S * fs)
+    n, half = 40 * window, 20 * window
+    frames = {False: Rotation.identity(n)}
+    vectors = np.where(np.arange(n)[:, None] < half, [0.0, 0.0, g], [g, 0.0, 0.0])
+    joined = axes.mismatches(frames, vectors, fs, maps=MAPS[:1], min_turn=0.0, joins=[20])
+    plain = axes.mismatches(frames, vectors, fs, maps=MAPS[:1], min_turn=0.0)
+    assert joined[(0, False)] == 0.0
+    assert plain[(0, False)] == pytest.approx(2 * g * g / 39, rel=1e-12)
+
+
+def test_a_long_recording_is_checked_on_stretches_spread_over_it():
+    """Beyond CHECK_S (300 s) the check runs on PARTS stretches of whole windows, CHECK_S in all,
+    one at the start of each of as many equal parts, joined at the windows that begin them; on
+    900 s of human motion an accelerometer on other axes is still named, and the recording in its
+    own axes gets no note."""
+    n = round(900.0 * FS)
+    rows, joins = axes._checked_rows(n, FS)
+    assert len(rows) == round(axes.CHECK_S * FS) and joins == [50, 100]  # 2-s windows of every 2nd sample
+    starts = rows[np.flatnonzero(np.diff(rows, prepend=-2) != 1)]
+    assert list(starts) == [0, n // 3, 2 * n // 3]
+    assert axes._checked_rows(round(axes.CHECK_S * FS), FS)[1] == []  # up to CHECK_S: every row
+    motion = HumanMotion(delta_v=0.25, omega_c=5.0, rot_rms=0.5).generate(900.0, FS, seed=7)
+    imu = ImuModel(delta_n=math.radians(0.1), gyr_offset=(0.02, -0.01, 0.005))
+    gyr, acc = imu.apply(motion, seed=8)
+    assert axes.axes_notes("long", gyr, acc, None, FS) == []
+    notes = axes.axes_notes("long", gyr, acc @ parse_axes("y,-x,z"), None, FS)
+    assert len(notes) == 1 and "with --acc-axes=y,-x,z it is" in notes[0], notes

@@ -17,6 +17,13 @@ with the gyro as it is and reversed (a clockwise-positive gyro); a map that fits
 MISMATCH_RATIO times better than the recording as given and than any other is named with
 the flags that apply it, and nothing is said where the given axes' mismatch is below
 SIGNIFICANT of the vector's mean square (the few degrees gyro drift and motion make).
+
+A recording longer than CHECK_S is checked on PARTS stretches of CHECK_S/PARTS each, one at the
+start of each of as many equal parts of it, joined (the gyro integrated on through a join, whose
+pair of windows is left out): the cost stays that of CHECK_S whatever the length (on a 17-minute
+recording at 1 kHz the whole of it took a quarter of a second, a fifth of `attitude estimate`'s
+time on Parquet), and an axis convention, which holds for the whole recording, shows in any
+stretch of it that turns.
 """
 from __future__ import annotations
 
@@ -36,6 +43,8 @@ MIN_WINDOWS = 20  # fewer turning pairs of windows than this: no verdict
 MISMATCH_RATIO = 4.0  # how much better a map must fit to be named
 SIGNIFICANT = 0.01  # nor is a mismatch below this share of the vector's mean square (≈ 6° of direction: drift's)
 WINDOW_SAMPLES = 100  # at most about this many samples of a window, evenly spread, enter its means
+CHECK_S = 300.0  # s: a longer recording is checked on PARTS stretches of CHECK_S/PARTS, spread over it
+PARTS = 3
 
 
 def parse_axes(text: str) -> np.ndarray:
@@ -101,13 +110,14 @@ def _window_means(frames: Rotation, vectors, finite, window: int):
 
 
 def mismatches(frames: dict, vectors, fs: float, hard_iron: bool = False, maps=MAPS,
-               min_turn: float = MIN_TURN_RAD) -> dict | None:
+               min_turn: float = MIN_TURN_RAD, joins=()) -> dict | None:
     """{(map index in maps, gyro reversed): mean-square mismatch} (units² of vectors) of
     every map of vectors (N×3; rows with a NaN are not used), in frames ({gyro reversed:
     the N frames _orientations integrates from the gyro, or from its negative}): the gyro
     as it is and, where frames has it and unless hard_iron (the magnetometer: its offset is
     fitted per map), reversed; None where fewer than MIN_WINDOWS pairs of windows turn by
-    min_turn (rad) or more."""
+    min_turn (rad) or more. joins: the windows that begin a stretch joined to the one before
+    (_checked_rows); the pair across each is left out."""
     window = _window(fs)
     blocks = len(vectors) // window
     if blocks < MIN_WINDOWS:
@@ -122,6 +132,7 @@ def mismatches(frames: dict, vectors, fs: float, hard_iron: bool = False, maps=M
         centres = turned[window // 2::window]
         turn = (centres[:-1].inv() * centres[1:]).magnitude()
         pairs = np.flatnonzero((turn >= min_turn) & sampled[:-1] & sampled[1:])
+        pairs = pairs[~np.isin(pairs + 1, joins)]
         if len(pairs) < MIN_WINDOWS:
             return None
         mean_frame, products = _window_means(turned, vectors, finite, window)
@@ -168,32 +179,47 @@ def axes_notes(name: str, gyr, acc, mag, fs: float, gyr_unit: str = "rad/s") -> 
     means are taken over every _step(fs)-th."""
     if len(gyr) // _window(fs) < MIN_WINDOWS:  # too short for a verdict (mismatches): nothing integrated
         return []
+    rows, joins = _checked_rows(len(gyr), fs)
+    gyr, acc, mag = gyr[rows], acc[rows], None if mag is None else mag[rows]
     step = _step(fs)
     frames = {False: _orientations(gyr, fs, step), True: _orientations(-gyr, fs, step)}  # for both sensors
     acc, mag, fs_used = acc[step - 1::step], None if mag is None else mag[step - 1::step], fs / step
-    unit = gyro_unit_note(name, gyr, acc, mag, fs, gyr_unit, frames[False])
+    unit = gyro_unit_note(name, gyr, acc, mag, fs, gyr_unit, frames[False], joins)
     if unit:
         return [unit]
     mean_square = lambda v: float(np.nanmean(np.sum(v**2, axis=1)))
-    notes = [axes_note(name, "the accelerometer", "--acc-axes", "m/s²", mismatches(frames, acc, fs_used),
-                       mean_square(acc))]
+    notes = [axes_note(name, "the accelerometer", "--acc-axes", "m/s²",
+                       mismatches(frames, acc, fs_used, joins=joins), mean_square(acc))]
     if mag is not None:
         notes.append(axes_note(name, "the magnetometer", "--mag-axes", "µT",
-                               mismatches(frames, mag, fs_used, hard_iron=True), mean_square(mag)))
+                               mismatches(frames, mag, fs_used, hard_iron=True, joins=joins), mean_square(mag)))
     return [note for note in notes if note]
 
 
-def gyro_unit_note(name: str, gyr, acc, mag, fs: float, gyr_unit: str, frames: Rotation) -> str | None:
+def _checked_rows(n: int, fs: float) -> tuple[slice | np.ndarray, list[int]]:
+    """(rows, joins) the check runs on in a recording of n samples at fs (Hz): every row where
+    it is no longer than CHECK_S; else PARTS stretches of CHECK_S/PARTS each (whole windows of
+    every _step(fs)-th sample), one at the start of each of as many equal parts, and joins, the
+    window each stretch but the first begins with among the windows of the rows taken."""
+    if n <= CHECK_S * fs:
+        return slice(None), []
+    per_window = _step(fs) * _window(fs / _step(fs))  # samples a window of the rows taken spans
+    windows = max(1, int(CHECK_S / PARTS * fs) // per_window)
+    starts = np.arange(PARTS) * n // PARTS
+    return (starts[:, None] + np.arange(windows * per_window)).ravel(), [k * windows for k in range(1, PARTS)]
+
+
+def gyro_unit_note(name: str, gyr, acc, mag, fs: float, gyr_unit: str, frames: Rotation, joins=()) -> str | None:
     """A note naming --gyr-unit where, with the gyro (at fs, Hz) read in another unit (a
     factor of 57.3 or 1000 from gyr_unit; frames: those integrated from it as read, at
     every _step(fs)-th sample, as acc and mag are taken), the
     accelerometer and the magnetometer (if any) stay put in the gyro's frame
     MISMATCH_RATIO times better than as read, on every pair of windows whether the gyro
     says they turn or not (the unit that fits best); nothing where the mismatch as read is below SIGNIFICANT of the
-    accelerometer's mean square."""
+    accelerometer's mean square. joins: as mismatches takes them."""
     sensors = [(acc, False)] + ([(mag, True)] if mag is not None else [])
     step = _step(fs)
-    score = lambda turned, v, hard_iron: (mismatches({False: turned}, v, fs / step, hard_iron, MAPS[:1], 0.0)
+    score = lambda turned, v, hard_iron: (mismatches({False: turned}, v, fs / step, hard_iron, MAPS[:1], 0.0, joins)
                                           or {}).get((0, False))
     given = [score(frames, v, h) for v, h in sensors]
     if given[0] is None or given[0] < SIGNIFICANT * float(np.nanmean(np.sum(acc**2, axis=1))):

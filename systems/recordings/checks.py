@@ -32,16 +32,19 @@ PILE_LEAST = (10, 0.001)  # ... and at least this many samples and this share of
 RANGE_MATCH = 0.1  # a pile-up within this share of a usual full-scale range is named with it
 ACC_RANGES_G = (2, 4, 6, 8, 12, 16, 24, 32, 64, 100, 200, 400)  # usual accelerometer ranges, ±g
 GYR_RANGES_DEG_S = (125, 250, 300, 500, 1000, 2000, 4000)  # usual gyro ranges, ±°/s
+NORM_ROWS = 100_000  # rows, evenly spread, whose median the field's norm is taken from (a unit's factor of 2)
 
 
 def field_norm_note(rec: Recording) -> str | None:
-    """A note when the magnetometer's median norm (µT after the unit conversion) is far
-    from the earth's field: a unit not given, or a sensor that reports raw counts. The
-    heading and hard-iron estimators use directions and relative norms only, so they work
-    in any unit; only the hard-iron offset is then reported in the input's unit."""
+    """A note when the magnetometer's median norm (µT after the unit conversion; over at most
+    about NORM_ROWS rows, evenly spread) is far from the earth's field: a unit not given, or a
+    sensor that reports raw counts. The heading and hard-iron estimators use directions and
+    relative norms only, so they work in any unit; only the hard-iron offset is then reported in
+    the input's unit."""
     if rec.mag is None:
         return None
     rows = rec.mag[all_of_row(np.isfinite(rec.mag))]  # read_recording leaves no magnetometer without a sample
+    rows = rows[::max(1, len(rows) // NORM_ROWS)]
     norm = float(np.median(np.linalg.norm(rows, axis=1)))
     low, high = EARTH_FIELD_RANGE_UT
     if low / 2 <= norm <= 2 * high:
