@@ -176,7 +176,7 @@ def axes_notes(name: str, gyr, acc, mag, fs: float, gyr_unit: str = "rad/s") -> 
     """The notes of axes_note on a recording's accelerometer and magnetometer (or None),
     or, where the gyro read in another unit than gyr_unit makes them turn as it says,
     gyro_unit_note's instead. The gyro is integrated over every sample, the windows'
-    means are taken over every _step(fs)-th."""
+    means are taken over every _step(fs)-th; beyond CHECK_S, on _checked_rows' stretches."""
     if len(gyr) // _window(fs) < MIN_WINDOWS:  # too short for a verdict (mismatches): nothing integrated
         return []
     rows, joins = _checked_rows(len(gyr), fs)
