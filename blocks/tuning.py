@@ -125,6 +125,8 @@ GYRO_OFFSET = (
     Param("tau_lp", 0.5, "s", "time constant of the low-passes of the rest detection", **TIME_S),
     Param("tau_short", 0.02, "s", "time constant of the low-pass that takes white noise out of the samples the rest "
           "detection compares with its low-passes (human motion lies below 8 Hz)", **TIME_S),
+    Param("tau_rest", 0.15, "s", "time constant of the low-pass of the gyro whose samples at rest measure the offset: "
+          "a rest's last tremor, and a turn that has not quite stopped, averaged out", **TIME_S),
     GYRO_DENSITY,
     Param("tau_acc", 3.0, "s", "time constant of the accelerometer low-pass in the gyro frame (motion tracking)",
           **TIME_S),
@@ -132,6 +134,9 @@ GYRO_OFFSET = (
           **RATE_RAD_S),
     SIGMA_MOTION,
     Param("tau_motion", 100.0, "s", "time in which the offset may drift by sigma_motion; 0: no tracking while moving",
+          allow_zero=True, high=1e6),
+    Param("tau_arm", 30.0, "s", "memory of the online lever-arm fit (a sensor turned about a fixed centre: its "
+          "accelerations removed from the accelerometer where the fit explains them); 0, or tau_motion 0: no lever arm",
           allow_zero=True, high=1e6),
 )
 

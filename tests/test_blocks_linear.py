@@ -128,7 +128,8 @@ def test_the_gyro_offset_estimator_rests_on_a_constant_offset():
     offset = np.array([0.002, -0.001, 0.003])  # rad/s, inside rest_gyr_abs
     block = af.offset_system(TS)
     rest = af.rest_point(block, [*offset, 0.0, 0.0, STANDARD_GRAVITY])
-    assert np.allclose(rest.outputs[3:], offset, atol=1e-9) and np.allclose(rest.outputs[:3], 0.0, atol=1e-9)
+    assert np.allclose(rest.outputs[3:6], offset, atol=1e-9) and np.allclose(rest.outputs[:3], 0.0, atol=1e-9)
+    assert np.array_equal(rest.outputs[6:], rest.inputs[3:])  # the accelerometer as measured: no lever arm at rest
     assert finite(control.linearize(block, rest))
 
 

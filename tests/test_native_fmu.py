@@ -375,7 +375,7 @@ def test_the_model_description_validates_and_matches_the_pythonfmu_fmu(fmus, md,
         return [(v.name, v.valueReference, v.type, v.causality, v.variability, v.initial, v.unit, str(v.start),
                  v.description) for v in description.modelVariables]
     assert table(md) == table(theirs)
-    assert len(md.modelVariables) == 75 and md.coSimulation.canGetAndSetFMUstate
+    assert len(md.modelVariables) == 77 and md.coSimulation.canGetAndSetFMUstate
     assert [u.name for u in md.unitDefinitions] == [u.name for u in theirs.unitDefinitions]
     assert md.guid != theirs.guid
 
@@ -569,6 +569,30 @@ def test_a_broad_recording_and_a_long_stream_give_the_python_step(runner, unzipp
         results = replay_configs(runner["plain"], binary, md, vr, configs, rows, broad, params={"Ts": ts})
         for config, result in zip(configs, results):
             assert_equal(result, reference(config, rows), config)
+    finally:
+        TS = saved
+
+
+def test_a_robot_wrist_s_lever_arm_is_removed_in_the_fmu_as_in_the_python_step(runner, unzipped, md, vr, tmp_path):
+    """robot_arm (systems.simulation.scenarios), its first 40 s at 125 Hz, where the gyro-offset stage's
+    online lever arm is taken from 10.2 s on: the FMU at its defaults (wiener, 6D and 9D) gives the python
+    step's outputs, which differ from those without the arm (tau_arm 0) by more than rounding."""
+    from attitude_fmu.systems.simulation.scenarios import scenario
+
+    rec = scenario("robot_arm").recording(name="robot_arm")
+    ts, n = 1.0 / rec.fs, int(40 * rec.fs)
+    rows = np.column_stack([np.arange(n) * ts, np.full(n, ts), rec.gyr[:n], rec.acc[:n], rec.mag[:n]])
+    default = {"method": "wiener", "gyro_offset": "on", "gyr_samples": "mean", "acc_samples": "point", "latency": 0.0}
+    configs = [{**default, "heading": heading} for heading in ("gyro", "mag")]
+    global TS
+    saved, TS = TS, ts  # the FMU's Ts set to the recording's
+    try:
+        binary = unzipped / native.binary_path("AttitudeEstimator")
+        results = replay_configs(runner["plain"], binary, md, vr, configs, rows, tmp_path, params={"Ts": ts})
+        for config, result in zip(configs, results):
+            assert_equal(result, reference(config, rows), config)
+            without = reference(config, rows, {"tau_arm": 0.0})[0]
+            assert np.abs(result[0][:, :4] - without[:, :4]).max() > 1e-4, config
     finally:
         TS = saved
 

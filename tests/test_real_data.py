@@ -10,12 +10,14 @@ import numpy as np
 import pytest
 from scipy import integrate
 from scipy.io import loadmat, savemat
+from scipy.signal import lfilter
 from scipy.spatial.transform import Rotation
 
 from attitude_fmu.blocks.errors import inclination_error, quaternion_errors, rms
 from attitude_fmu.blocks.filters import accuracy as ac
 from attitude_fmu.blocks.filters import earth_filters as ef
 from attitude_fmu.blocks.pipeline.batch import estimate
+from attitude_fmu.blocks.stages import gyro_offset
 from attitude_fmu.blocks.stages.gyro_offset import correct as correct_gyro
 from attitude_fmu.blocks.stages.heading import with_magnetometer
 from attitude_fmu.blocks.stages.scale_error import SCALE_ERRORS
@@ -134,11 +136,12 @@ def test_a_gyro_told_noisier_raises_the_rest_threshold_above_its_noise():
 
 
 def test_a_short_rest_gives_the_mean_of_its_gyro_samples():
-    """A 2 °/s offset and 10 s at rest: once rest is detected (1.5 s) each gyro sample
-    counts with the white-noise variance r = δn²·fs/2 of the default δn = 0.1 °/s/√Hz, so
-    the estimate is the Kalman mean of a constant: the rest's n samples against the prior
-    (0, σ_init² = (0.5 °/s)²), Σg/(n + r/σ_init²), not an average still forgetting its start
-    (the offset's allowed drift, σ_motion per τ_motion, weights late samples a little more)."""
+    """A 2 °/s offset and 10 s at rest: once rest is detected (1.5 s) each gyro sample, low-passed
+    over tau_rest from the rest's start, counts with the white-noise variance r = δn²·fs/2 of the
+    default δn = 0.1 °/s/√Hz, so the estimate is the Kalman mean of a constant: the rest's n
+    low-passed samples against the prior (0, σ_init² = (0.5 °/s)²), Σg/(n + r/σ_init²), not an
+    average still forgetting its start (the offset's allowed drift, σ_motion per τ_motion, weights
+    late samples a little more)."""
     rng = np.random.default_rng(7)
     n = int(10 * FS)
     offset = np.radians([2.0, -1.0, 1.5])
@@ -148,8 +151,10 @@ def test_a_short_rest_gives_the_mean_of_its_gyro_samples():
     rest_from = int(np.argmax(np.abs(estimate_).sum(axis=1) > 0))
     assert abs(rest_from - 1.5 * FS) <= 1  # the rest conditions hold from the first sample on
     prior_weight = (math.radians(0.1) ** 2 * FS / 2) / math.radians(0.5) ** 2
+    a = 1.0 - math.exp(-1.0 / (FS * gyro_offset.resolve()["tau_rest"]))
+    low_passed = lfilter([a], [1.0, a - 1.0], gyr, axis=0, zi=(1.0 - a) * gyr[:1])[0]  # from gyr[0], at rest
     for k in (int(3 * FS), n - 1):
-        mean = gyr[rest_from:k + 1].sum(axis=0) / (k + 1 - rest_from + prior_weight)
+        mean = low_passed[rest_from:k + 1].sum(axis=0) / (k + 1 - rest_from + prior_weight)
         assert np.degrees(np.abs(estimate_[k] - mean)).max() < 0.005  # °/s
     assert np.degrees(np.abs(estimate_[-1] - offset)).max() < 0.03  # 4 σ of 850 samples' mean
 
@@ -264,9 +269,11 @@ def test_a_raw_phone_gyros_offset_is_found_at_its_first_rest():
 def test_offline_a_slow_onset_of_motion_is_not_taken_for_rest():
     """5 s at rest, then turns of 90° about the vertical of minimum jerk (1.2 s; rate 30·s²(1 − s)²·θ/T, which
     starts too slowly to break the rest at once) between 0.5-s dwells, then 5 s at rest; a calibrated gyro
-    (0.004 °/s/√Hz) with a known offset, the accelerometer still. Forward in time the onset's first samples
-    count as rest and shift the vertical offset by 0.012 °/s; offline a rest's sample counts only where
-    the rest holds rest_time after it too, and the offset stays within 0.005 °/s of the truth over the motion."""
+    (0.004 °/s/√Hz) with a known offset, the accelerometer still. Forward in time, with each raw sample
+    measuring the offset (tau_rest → 0), the onset's first samples count as rest and shift the vertical
+    offset by 0.012 °/s; through tau_rest's low-pass, which lags the onset, by 0.002 °/s; offline a rest's
+    sample counts only where the rest holds rest_time after it too. Both stay within 0.005 °/s of the
+    truth over the motion."""
     rng = np.random.default_rng(1)
     s = np.arange(int(1.2 * FS)) / (1.2 * FS)
     rate = math.radians(90.0) / 1.2 * 30.0 * s ** 2 * (1.0 - s) ** 2
@@ -278,11 +285,12 @@ def test_offline_a_slow_onset_of_motion_is_not_taken_for_rest():
     gyr += rng.normal(0.0, math.radians(0.004) * math.sqrt(FS / 2), (n, 3))
     acc = np.tile([0.0, 0.0, 9.81], (n, 1)) + rng.normal(0.0, 6e-4, (n, 3))
     motion = slice(int(5 * FS), n - int(5 * FS))
-    errors = {offline: np.degrees(correct_gyro(gyr, acc, FS, offline=offline)[1] - offset)[motion, 2]
-              for offline in (False, True)}
-    print({offline: round(float(np.abs(e).max()), 4) for offline, e in errors.items()})
-    assert np.abs(errors[False]).max() > 0.008  # °/s: forward, the onset taken for rest
-    assert np.abs(errors[True]).max() < 0.005
+    errors = {(offline, raw): np.degrees(correct_gyro(gyr, acc, FS, {"tau_rest": 1e-9} if raw else None,
+                                                      offline=offline)[1] - offset)[motion, 2]
+              for offline, raw in ((False, True), (False, False), (True, False))}
+    print({key: round(float(np.abs(e).max()), 4) for key, e in errors.items()})
+    assert np.abs(errors[False, True]).max() > 0.008  # °/s: forward from raw samples, the onset taken for rest
+    assert np.abs(errors[False, False]).max() < 0.005 and np.abs(errors[True, False]).max() < 0.005
 
 
 @pytest.mark.parametrize("profile", ["lever_arm", "offset_rotation"])

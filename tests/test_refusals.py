@@ -90,17 +90,19 @@ def test_every_parameter_outside_its_range_is_refused_with_the_message_its_table
     (dict(params={"tau_heading": 5.0}),
      "unknown parameter 'tau_heading' (the method wiener: delta_n, delta_v, g, omega_g, omega_c, stationary, "
      "scale_error, omega_m, tau_noise, tau_v, delta_v_min; the gyro-offset estimator: rest_gyr, rest_gyr_abs, "
-     "rest_acc, rest_time, tau_lp, tau_short, delta_n, tau_acc, sigma_init, sigma_motion, tau_motion)"),
+     "rest_acc, rest_time, tau_lp, tau_short, tau_rest, delta_n, tau_acc, sigma_init, sigma_motion, tau_motion, "
+     "tau_arm)"),
     (dict(method="mahony", params={"delta_n": 0.001}, gyro_offset=False),
      "unknown parameter 'delta_n' (the method mahony: k_P, k_I, g)"),
     (dict(method="tseng", params={"k_P": 1.0}, heading=True),
      "unknown parameter 'k_P' (the method tseng: none; the gyro-offset estimator: rest_gyr, rest_gyr_abs, rest_acc, "
-     "rest_time, tau_lp, tau_short, delta_n, tau_acc, sigma_init, sigma_motion, tau_motion; the heading estimator: "
-     "tau_heading, delta_n, heading_drift, sigma_motion, mag_norm_tol, mag_dip_tol, tau_mag_guard, tau_reference, heading_clip, mag_new_time, "
-     "mag_new_angle, mag_delay, mag_cal_time, mag_cal_spread, mag_cal_tol, mag_cal_recent, tau_mag_delay)"),
+     "rest_time, tau_lp, tau_short, tau_rest, delta_n, tau_acc, sigma_init, sigma_motion, tau_motion, tau_arm; "
+     "the heading estimator: tau_heading, delta_n, heading_drift, sigma_motion, mag_norm_tol, mag_dip_tol, "
+     "tau_mag_guard, tau_reference, heading_clip, mag_new_time, mag_new_angle, mag_delay, mag_cal_time, mag_cal_spread, mag_cal_tol, mag_cal_recent, tau_mag_delay)"),
     (dict(method="mahony", params={"scale_error": 0.0}),
      "unknown parameter 'scale_error' (the method mahony: k_P, k_I, g; the gyro-offset estimator: rest_gyr, "
-     "rest_gyr_abs, rest_acc, rest_time, tau_lp, tau_short, delta_n, tau_acc, sigma_init, sigma_motion, tau_motion)"),
+     "rest_gyr_abs, rest_acc, rest_time, tau_lp, tau_short, tau_rest, delta_n, tau_acc, sigma_init, sigma_motion, "
+     "tau_motion, tau_arm)"),
     (dict(params={"delta_n": 1e300}), "parameter delta_n = 1e+300 rad/s/√Hz is outside its plausible range "
                                       "[1e-12, 1] rad/s/√Hz (gyro noise density, one-sided (datasheet))"),
     (dict(params={"stationary": 0.5}),

@@ -19,7 +19,7 @@ from attitude_fmu.blocks.stages import heading_choice, lever_arm, soft_iron
 from attitude_fmu.blocks.stages import scale_error
 from attitude_fmu.blocks.stages.delays import mag_delay
 from attitude_fmu.blocks.stages.gyro_offset import correct as correct_gyro
-from attitude_fmu.blocks.stages.gyro_offset import offset_estimate
+from attitude_fmu.blocks.stages.gyro_offset import online_pass
 from attitude_fmu.blocks.stages.hard_iron import back_dated
 from attitude_fmu.blocks.stages.heading import smoothed_with_magnetometer
 from attitude_fmu.blocks.stages.lever_arm import LeverArm
@@ -211,7 +211,8 @@ def _chosen_scale_error(pipeline: Pipeline, step: Step, gyr, acc, initial_gravit
     rate ⟨|ω|²⟩ (rad²/s²) and the mean variance of the offset removed from it ((rad/s)², 0 with
     no offset stage) over the rows it scored (None: the recording is too short): the method
     alone, on the samples as the pipeline turns them (its sample conventions, the gyro freed of
-    its offset by a forward pass), over the windows of scale_error.subset, one after another
+    its offset and the accelerometer of the online lever arm by a forward pass), over the
+    windows of scale_error.subset, one after another
     (each from the start at rest on its first rows, its warm-up with the method's default
     scale_error, each candidate on from there), or over every row from initial_gravity where
     that is None; the windows on up to threads threads at once (None: a thread for each CPU the
@@ -227,7 +228,7 @@ def _chosen_scale_error(pipeline: Pipeline, step: Step, gyr, acc, initial_gravit
         gyr, acc = np.concatenate([gyr[part] for part in parts]), np.concatenate([acc[part] for part in parts])
     variance = np.zeros_like(gyr)
     if pipeline.offset_params is not None:
-        offset, variance = offset_estimate(gyr, acc, fs, pipeline.offset_params)
+        offset, variance, acc = online_pass(gyr, acc, fs, pipeline.offset_params)
         gyr = gyr - offset
     own = dict(pipeline.params)
 

@@ -3,7 +3,9 @@
 At rest: the gyro and the accelerometer, each through a short low-pass (tau_short, which
 takes the white noise above human motion's band out), must stay close to their values
 low-passed over tau_lp (rest_gyr, rest_acc), and the gyro low-passed over tau_lp must
-stay small (rest_gyr_abs), for rest_time seconds; then each gyro sample measures the offset
+stay small (rest_gyr_abs), for rest_time seconds; then each gyro sample, low-passed over
+tau_rest from the rest's start (a rest's last tremor and a turn not quite stopped averaged
+out, as vqf measures a rest from its low-passed gyro), measures the offset
 with the variance of the gyro's white noise, delta_n²·fs/2, in the same Kalman filter as
 the tracking while moving: a first rest after an uncertain start gives the running mean
 of the rest's samples, and a long rest settles on a window of delta_n/sigma_motion·
@@ -33,6 +35,17 @@ c. Guards, all from the same model:
   sample, which in motion can be off by metres per second squared and would turn the
   low-passed direction for several tau_acc after; no update in the first 3·tau_acc,
   while the low-passes forget their start.
+The online lever arm (tau_arm; none where tau_motion is 0): a sensor turned about a fixed
+centre (a robot's wrist) reads α×r + ω×(ω×r) beside gravity, an acceleration a tilt filter
+takes for tilt and whose centripetal part keeps one sign in the sensor's frame. At about
+ARM_RATE_HZ (blocks/core/stages/gyro_offset.h) the accelerometer and those terms, both turned
+into the gyro frame (ω the corrected gyro's mean over the sample, α its difference) and
+high-passed over 10 s (gravity, and the slow turn an offset error gives the frame), feed
+least-squares sums that forget over tau_arm; their solution r (m, sensor coordinates) is
+removed from the accelerometer handed to the method from the next sample on, where it explains
+at least 90 % of what the high-pass leaves, at least 0.05 m/s² RMS of it, and is under 3 m
+(else nothing is removed: at rest, in hand-held motion, on a centre that moves itself).
+Offline the arm is fitted over the whole recording instead (blocks.stages.lever_arm).
 The corrected gyro is the measured one minus the estimate after its sample. Causal: one step
 per sample, in the C core (blocks/core/stages/gyro_offset.c); its parameters are
 blocks.tuning.GYRO_OFFSET.
@@ -69,16 +82,17 @@ def initial_state(coef, gyr0, acc0) -> np.ndarray:
 
 def offset_system(dt: float, params=None, name: str = "gyro_offset"):
     """Discrete python-control system of the estimator: inputs gyr_raw_x..z (rad/s, the
-    measured gyro) and acc_x..z (m/s²); outputs gyr_x..z, the gyro less the offset
-    estimate after the sample (rad/s), and offset_x..z. x0: initial_state, or the zero
-    state, with which it starts at rest on its first sample. Marked with its C step,
-    "gyro_offset" (the params given, as given)."""
+    measured gyro) and acc_raw_x..z (m/s², the measured accelerometer); outputs gyr_x..z, the
+    gyro less the offset estimate after the sample (rad/s), offset_x..z, and acc_x..z, the
+    accelerometer less the online lever arm's accelerations (m/s², the measured one where no
+    arm is proven). x0: initial_state, or the zero state, with which it starts at rest on its
+    first sample. Marked with its C step, "gyro_offset" (the params given, as given)."""
     coef = coefficients(resolve(params), dt)
 
     def advance(state, u):
-        offset, variance = np.empty((1, 3)), np.empty((1, 3))
-        _core.gyro_offset_run(state, coef, u[0:3].reshape(1, 3), u[3:6].reshape(1, 3), offset, variance)
-        return state, np.concatenate([u[0:3] - offset[0], offset[0]])
+        offset, variance, acc = np.empty((1, 3)), np.empty((1, 3)), np.empty((1, 3))
+        _core.gyro_offset_run(state, coef, u[0:3].reshape(1, 3), u[3:6].reshape(1, 3), offset, variance, acc_out=acc)
+        return state, np.concatenate([u[0:3] - offset[0], offset[0], acc[0]])
 
     def start(u):
         return initial_state(coef, u[0:3], u[3:6])
@@ -87,8 +101,9 @@ def offset_system(dt: float, params=None, name: str = "gyro_offset"):
         _core.gyro_offset_run(state, coef, np.ascontiguousarray(rows[:, 0:3]), np.ascontiguousarray(rows[:, 3:6]),
                               np.empty((len(rows), 3)), np.empty((len(rows), 3)))
 
-    system = sample_system(advance, [f"{s}_{a}" for s in ("gyr_raw", "acc") for a in "xyz"],
-                           [f"{s}_{a}" for s in ("gyr", "offset") for a in "xyz"], STATE_NAMES, dt, name, start=start)
+    system = sample_system(advance, [f"{s}_{a}" for s in ("gyr_raw", "acc_raw") for a in "xyz"],
+                           [f"{s}_{a}" for s in ("gyr", "offset", "acc") for a in "xyz"], STATE_NAMES, dt, name,
+                           start=start)
     return with_c_step(system, CStep("gyro_offset", dt, **given(params), start=True,
                                      rest=lambda u: resting(run, start(u), u, dt), rest_inputs=REST_INPUTS))
 
@@ -98,6 +113,18 @@ def correct(gyr, acc, fs: float, params=None, offline: bool = False):
     as offset_estimate does)."""
     offset, _ = offset_estimate(gyr, acc, fs, params, offline)
     return np.asarray(gyr, dtype=float) - offset, offset
+
+
+def online_pass(gyr, acc, fs: float, params=None):
+    """The estimator's causal pass over a whole recording (gyr N×3 rad/s, acc N×3 m/s², fs Hz):
+    (offset estimate N×3 rad/s, its variance per axis N×3 (rad/s)², acc freed of the online
+    lever arm's accelerations N×3 m/s², as the causal pipeline hands it to the method)."""
+    gyr = np.ascontiguousarray(gyr, dtype=float)
+    acc = np.ascontiguousarray(acc, dtype=float)
+    coef = coefficients(resolve(params), 1.0 / fs)
+    offset, variance, freed = np.empty_like(gyr), np.empty_like(gyr), np.empty_like(acc)
+    _core.gyro_offset_run(initial_state(coef, gyr[0], acc[0]), coef, gyr, acc, offset, variance, acc_out=freed)
+    return offset, variance, freed
 
 
 def offset_estimate(gyr, acc, fs: float, params=None, offline: bool = False):
@@ -123,7 +150,7 @@ def offset_estimate(gyr, acc, fs: float, params=None, offline: bool = False):
         return offset, variance, resting
 
     if not offline:
-        return one_pass(gyr, acc)[:2]
+        return online_pass(gyr, acc, fs, params)[:2]
     # a rest's sample measures the offset where the rest holds rest_time before and after it: a motion's onset,
     # which the detection still takes for rest, is then no rest backward in time
     backward = time_reversed(gyr), np.ascontiguousarray(acc[::-1])

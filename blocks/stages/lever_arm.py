@@ -21,7 +21,8 @@ motion (0.997 on the robot_arm scenario; 0.07–0.76 on BROAD's ten handheld tri
 simulated human motion with a lever arm and its own translation, where the centre moves: a
 fit there removes some accelerations and adds others). The accelerometer is then freed of
 A·r before the offline smoother runs; along a single axis of rotation no acceleration shows
-the arm, and whatever the fit leaves there moves nothing.
+the arm, and whatever the fit leaves there moves nothing. Online the gyro-offset stage fits the
+arm causally, over the last tau_arm s (blocks.stages.gyro_offset).
 """
 from __future__ import annotations
 

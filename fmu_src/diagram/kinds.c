@@ -29,7 +29,7 @@ static const size_t KIND_INPUTS[DIAGRAM_KINDS] = {
     [DIAGRAM_CLOSED_FORM] = 0, [DIAGRAM_ERROR] = 7,
 };
 static const size_t KIND_OUTPUTS[DIAGRAM_KINDS] = {
-    [DIAGRAM_METHOD] = 7, [DIAGRAM_FILTER] = 7, [DIAGRAM_GYRO_OFFSET] = 6, [DIAGRAM_HEADING] = 7,
+    [DIAGRAM_METHOD] = 7, [DIAGRAM_FILTER] = 7, [DIAGRAM_GYRO_OFFSET] = 9, [DIAGRAM_HEADING] = 7,
     [DIAGRAM_LATENCY] = 7, [DIAGRAM_IMU] = 6, [DIAGRAM_MAGNETOMETER] = 3, [DIAGRAM_HUMAN] = HUMAN_N_OUT,
     [DIAGRAM_CLOSED_FORM] = 10, [DIAGRAM_ERROR] = 1,
 };
@@ -329,8 +329,8 @@ void kind_step(const DiagramBlock *b, const KindCoef *c, const LtiMatrices *lti,
     switch (b->kind) {
     case DIAGRAM_METHOD:
     case DIAGRAM_FILTER: stepper_run(&c->stepper, next, u, u + 3, y, y + 3); break;
-    case DIAGRAM_GYRO_OFFSET: /* gyr - offset, offset */
-        gyro_offset_step(STATE(AfGyroOffset, next), &c->gyro_offset, u, u + 3, offset, variance);
+    case DIAGRAM_GYRO_OFFSET: /* gyr - offset, offset, acc less the lever arm's accelerations */
+        gyro_offset_step(STATE(AfGyroOffset, next), &c->gyro_offset, u, u + 3, offset, variance, y + 6);
         for (int i = 0; i < 3; i++) y[i] = u[i] - offset[i], y[3 + i] = offset[i];
         break;
     case DIAGRAM_HEADING: /* qh, mag_offset */

@@ -207,10 +207,9 @@ def exported_estimator(path: Path, fmi_version: str = "2.0", platforms: str = "h
     names = [f"{s}_{a}" for s in ("gyr", "acc") for a in "xyz"]
     diagram = control.interconnect(
         [offset_system(dt), estimator_system("wiener", dt=dt)], name="ExportedEstimator", inputs=names,
-        inplist=[f"gyro_offset.gyr_raw_{a}" for a in "xyz"] + [[f"gyro_offset.acc_{a}", f"estimator.acc_{a}"]
-                                                               for a in "xyz"],
+        inplist=[f"gyro_offset.{s}_raw_{a}" for s in ("gyr", "acc") for a in "xyz"],
         outlist=[f"estimator.{n}" for n in ("ghat_x", "ghat_y", "ghat_z", "q_w", "q_x", "q_y", "q_z")],
-        connections=[[f"estimator.gyr_{a}", f"gyro_offset.gyr_{a}"] for a in "xyz"])
+        connections=[[f"estimator.{s}_{a}", f"gyro_offset.{s}_{a}"] for s in ("gyr", "acc") for a in "xyz"])
     return export_fmu(diagram, path, fmi_version=fmi_version, platforms=platforms)
 
 

@@ -71,7 +71,7 @@ def closed_loop(motion: HumanMotion, imu: ImuModel, fs: float, method: str = "wi
     if imu.latency:  # the sensor's delay line, on a motion at rest, level, before the start
         states.append(imu.delay_state(fs, [0.0, 0.0, 0.0, 0.0, 0.0, motion.g]))
     if gyro_offset:
-        sensor.update_names(outputs=[f"{s}_{a}" for s in ("gyr_raw", "acc") for a in AXES])
+        sensor.update_names(outputs=[f"{s}_{a}" for s in ("gyr_raw", "acc_raw") for a in AXES])
         estimator.insert(0, offset_stage.offset_system(dt, offset_params))
         states.append(offset_stage.initial_state(offset_stage.coefficients(offset_stage.resolve(offset_params), dt),
                                                 np.zeros(3), np.array([0.0, 0.0, motion.g])))

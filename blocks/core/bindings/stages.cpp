@@ -179,7 +179,8 @@ void bind_stages(nb::module_ &m)
     }, nb::arg("coef"), nb::arg("gyr0"), nb::arg("acc0"),
           "The state on the first samples gyr0 (rad/s) and acc0 (m/s²): at rest, no offset.");
     m.def("gyro_offset_run", [](Vector state, const Vector &coef, const Rows3 &gyr, const Rows3 &acc, Rows3 offset,
-                                Rows3 variance, std::optional<Flags> allowed, std::optional<Flags> resting) {
+                                Rows3 variance, std::optional<Flags> allowed, std::optional<Flags> resting,
+                                std::optional<Rows3> acc_out) {
         AfGyroOffset *s = as<AfGyroOffset>(state, "state");
         const AfGyroOffsetCoef *c = as<AfGyroOffsetCoef>(coef, "coef");
         size_t n = gyr.shape(0);
@@ -188,19 +189,21 @@ void bind_stages(nb::module_ &m)
         check_rows(variance.shape(0), n, "variance");
         if (allowed) check_rows(allowed->shape(0), n, "allowed");
         if (resting) check_rows(resting->shape(0), n, "resting");
+        if (acc_out) check_rows(acc_out->shape(0), n, "acc_out");
         auto flags = [](std::optional<Flags> &f) {
             return f ? reinterpret_cast<unsigned char *>(f->data()) : nullptr;
         };
         nb::gil_scoped_release unlocked;
         gyro_offset_run(s, c, n, gyr.data(), acc.data(), flags(allowed), offset.data(), variance.data(),
-                        flags(resting));
+                        acc_out ? acc_out->data() : nullptr, flags(resting));
     }, nb::arg("state").noconvert(), nb::arg("coef"), nb::arg("gyr"), nb::arg("acc"), nb::arg("offset").noconvert(),
           nb::arg("variance").noconvert(), nb::arg("allowed").none() = nb::none(),
-          nb::arg("resting").noconvert().none() = nb::none(),
+          nb::arg("resting").noconvert().none() = nb::none(), nb::arg("acc_out").noconvert().none() = nb::none(),
           "Over N samples gyr (N×3, rad/s), acc (N×3, m/s²): the offset estimate after each (N×3, rad/s)\n"
           "and its variance per axis (N×3, (rad/s)²) into offset and variance; state in place. allowed (N\n"
           "flags; None: all): a sample at rest measures the offset only where set; resting (N flags, None:\n"
-          "not wanted): whether the rest had held rest_time at each sample.");
+          "not wanted): whether the rest had held rest_time at each sample; acc_out (N×3, m/s², None: not\n"
+          "wanted): acc freed of the online lever arm's accelerations.");
 
     // ---- heading, with the hard-iron fit and the magnetometer's delay
     nb::list heading_names;

@@ -174,7 +174,8 @@ static void timing_rows(const AfPipeline *pipeline, const AfStep *step, AfState 
         sample_timing(pipeline, step, state, handover->gyr + 3 * k, handover->acc + 3 * k);
 }
 
-/* stage 2 over rows [i, j): the offset estimated and removed from the hand-over's gyr */
+/* stage 2 over rows [i, j): the offset estimated and removed from the hand-over's gyr, the lever arm's
+ * accelerations from its acc */
 static void offset_rows(const AfStep *step, AfState *state, size_t i, size_t j, int starts,
                         const AfHandover *handover, const AfRows *out)
 {
@@ -185,7 +186,7 @@ static void offset_rows(const AfStep *step, AfState *state, size_t i, size_t j, 
         if (starts && k == 0)
             gyro_offset_initial_state(&step->offset_coef, g, a, &state->offset);
         gyro_offset_step(&state->offset, &step->offset_coef, g, a, b,
-                         out->offset_variance != NULL ? out->offset_variance + 3 * (i + k) : variance);
+                         out->offset_variance != NULL ? out->offset_variance + 3 * (i + k) : variance, a);
         for (int c = 0; c < 3; c++)
             g[c] -= b[c];
     }

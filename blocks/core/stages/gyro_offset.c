@@ -25,6 +25,7 @@ int gyro_offset_coefficients(const double params[AF_N_PARAMS], double Ts, AfGyro
     coef->Ts = Ts;
     coef->a_lp = 1.0 - exp(-Ts / params[AF_P_tau_lp]);
     coef->a_short = 1.0 - exp(-Ts / params[AF_P_tau_short]);
+    coef->a_rest = 1.0 - exp(-Ts / params[AF_P_tau_rest]);
     coef->r = delta_n * delta_n / (2.0 * Ts);
     coef->rest_gyr = noise_floor > params[AF_P_rest_gyr] ? noise_floor : params[AF_P_rest_gyr];
     coef->rest_gyr_abs = params[AF_P_rest_gyr_abs];
@@ -37,6 +38,14 @@ int gyro_offset_coefficients(const double params[AF_N_PARAMS], double Ts, AfGyro
     coef->tau_acc = sqrt(2.0) * Ts / wt;
     coef->settle = SETTLE_TAUS * coef->tau_acc;
     coef->clip = CLIP_SIGMAS * sqrt(coef->P0);
+    double every = floor(1.0 / (ARM_RATE_HZ * Ts) + 0.5), tau_arm = params[AF_P_tau_arm];
+    coef->arm_every = coef->a_arm = coef->arm_keep = coef->arm_floor = 0.0; /* no lever arm */
+    if (V > 0 && tau_arm > 0) {
+        coef->arm_every = every > 1.0 ? every : 1.0;
+        coef->a_arm = 1.0 - exp(-coef->arm_every * Ts / ARM_HIGHPASS_S);
+        coef->arm_keep = exp(-coef->arm_every * Ts / tau_arm);
+        coef->arm_floor = ARM_SHOWN_MIN * ARM_SHOWN_MIN / (1.0 - coef->arm_keep);
+    }
     return af_finite(coef, sizeof *coef, NULL) ? 0 : -1;
 }
 
@@ -45,7 +54,7 @@ void gyro_offset_initial_state(const AfGyroOffsetCoef *coef, const double gyr0[3
 {
     memset(state, 0, sizeof *state);
     for (int i = 0; i < 3; i++) {
-        state->lp_gyr[i] = state->short_gyr[i] = gyr0[i];
+        state->lp_gyr[i] = state->short_gyr[i] = state->arm_gyr[i] = gyr0[i];
         state->lp_acc[i] = state->short_acc[i] = acc0[i];
         state->r_lp[0][4 * i] = 1.0; /* LP(R) settled on I */
         state->P[4 * i] = coef->P0;   /* P0 on the diagonal */
@@ -190,6 +199,75 @@ static void motion_update(double b[3], double P[9], const double old[3], const d
     }
 }
 
+/* arm_accelerations: A.r = alpha x r + w x (w x r) */
+static void arm_accelerations(const double w[3], const double alpha[3], const double r[3], double out[3])
+{
+    double wr[3] = {w[1] * r[2] - w[2] * r[1], w[2] * r[0] - w[0] * r[2], w[0] * r[1] - w[1] * r[0]};
+    out[0] = alpha[1] * r[2] - alpha[2] * r[1] + w[1] * wr[2] - w[2] * wr[1];
+    out[1] = alpha[2] * r[0] - alpha[0] * r[2] + w[2] * wr[0] - w[0] * wr[2];
+    out[2] = alpha[0] * r[1] - alpha[1] * r[0] + w[0] * wr[1] - w[1] * wr[0];
+}
+
+/* arm_fit: one of the online lever arm's fit samples (every arm_every samples): y = R.acc (the accelerometer in
+ * the gyro frame) and X = R.A (A.r = alpha x r + w x (w x r)), each less its low-pass over ARM_HIGHPASS_S
+ * (gravity, and the slow turn the offset's error gives it), into forgetting sums; r = (X^T.X)^-1 X^T.y, the
+ * arm (m, sensor coordinates), kept where it explains at least ARM_EXPLAINED of sum |y|^2 (rotation about a
+ * fixed centre is then nearly all the motion) and at least ARM_SHOWN_MIN RMS, is at most ARM_MAX_M long, and
+ * ARM_SAMPLES_MIN samples or more carry sum |y|^2, else none; none before the high-pass has settled. */
+static void arm_fit(AfGyroOffset *state, const AfGyroOffsetCoef *coef, const double R[9], const double y[3],
+                    const double w[3], const double alpha[3])
+{
+    double A[9], X[9], dy[3], dX[9];
+    double w2 = dot(w, w);
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            A[3 * i + j] = w[i] * w[j] - (i == j ? w2 : 0.0);
+    A[1] -= alpha[2], A[2] += alpha[1], A[5] -= alpha[0];
+    A[3] += alpha[2], A[6] -= alpha[1], A[7] += alpha[0];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            X[3 * i + j] = R[3 * i] * A[j] + R[3 * i + 1] * A[3 + j] + R[3 * i + 2] * A[6 + j];
+    if (state->arm_time == 0.0) { /* the high-pass starts on its first sample */
+        memcpy(state->arm_y, y, sizeof state->arm_y);
+        memcpy(state->arm_x, X, sizeof state->arm_x);
+    }
+    for (int i = 0; i < 3; i++)
+        dy[i] = y[i] - (state->arm_y[i] += coef->a_arm * (y[i] - state->arm_y[i]));
+    for (int i = 0; i < 9; i++)
+        dX[i] = X[i] - (state->arm_x[i] += coef->a_arm * (X[i] - state->arm_x[i]));
+    static const int row[6] = {0, 0, 0, 1, 1, 2}, col[6] = {0, 1, 2, 1, 2, 2};
+    double keep = coef->arm_keep, *N = state->arm_normal, *B = state->arm_moment;
+    for (int e = 0; e < 6; e++) { /* (X^T.X)[row][col] */
+        int i = row[e], j = col[e];
+        N[e] = keep * N[e] + dX[i] * dX[j] + dX[3 + i] * dX[3 + j] + dX[6 + i] * dX[6 + j];
+    }
+    for (int i = 0; i < 3; i++)
+        B[i] = keep * B[i] + dX[i] * dy[0] + dX[3 + i] * dy[1] + dX[6 + i] * dy[2];
+    double dy2 = dot(dy, dy);
+    state->arm_total = keep * state->arm_total + dy2;
+    state->arm_square = keep * state->arm_square + dy2 * dy2;
+    state->arm_time += coef->arm_every * coef->Ts;
+    state->arm[0] = state->arm[1] = state->arm[2] = 0.0;
+    if (state->arm_time < ARM_HIGHPASS_S || !(state->arm_total > coef->arm_floor) ||
+        !(state->arm_total * state->arm_total >= ARM_SAMPLES_MIN * state->arm_square))
+        return;
+    double ridge = ARM_RIDGE * (N[0] + N[3] + N[5]) / 3.0;
+    double a = N[0] + ridge, b = N[1], c = N[2], d = N[3] + ridge, e = N[4], f = N[5] + ridge;
+    double adj[6] = {d * f - e * e, c * e - b * f, b * e - c * d, a * f - c * c, b * c - a * e, a * d - b * b};
+    double det = a * adj[0] + b * adj[1] + c * adj[2];
+    if (!(det > 0.0))
+        return;
+    double r[3] = {(adj[0] * B[0] + adj[1] * B[1] + adj[2] * B[2]) / det,
+                   (adj[1] * B[0] + adj[3] * B[1] + adj[4] * B[2]) / det,
+                   (adj[2] * B[0] + adj[4] * B[1] + adj[5] * B[2]) / det};
+    double Nr[3] = {N[0] * r[0] + N[1] * r[1] + N[2] * r[2], N[1] * r[0] + N[3] * r[1] + N[4] * r[2],
+                    N[2] * r[0] + N[4] * r[1] + N[5] * r[2]};
+    double explained = 2.0 * dot(r, B) - dot(r, Nr);
+    if (explained >= ARM_EXPLAINED * state->arm_total && explained >= coef->arm_floor &&
+        dot(r, r) <= ARM_MAX_M * ARM_MAX_M)
+        memcpy(state->arm, r, sizeof state->arm);
+}
+
 /* unit: q scaled to unit norm where it is that to rounding (one Newton step), else exactly */
 static Quat unit(Quat q)
 {
@@ -203,8 +281,9 @@ static Quat unit(Quat q)
 /* gyro_offset_step, a rest's sample taken as a measurement of the offset only where allowed; whether the rest
  * has held rest_time at the sample into *resting (NULL: not wanted) */
 static inline void step(AfGyroOffset *state, const AfGyroOffsetCoef *coef, const double gyr[3], const double acc[3],
-                        int allowed, double offset[3], double variance[3], unsigned char *resting)
+                        int allowed, double offset[3], double variance[3], double *acc_out, unsigned char *resting)
 {
+    double removed[3] = {0.0, 0.0, 0.0}; /* the lever arm's accelerations, removed from acc into acc_out */
     double Ts = coef->Ts, V = coef->V;
     /* the inputs read and the offset estimate b and its covariance P updated in place: copies on the stack,
      * stored a double at a time and read back two at a time by the vectorised code, stall the loads */
@@ -222,6 +301,9 @@ static inline void step(AfGyroOffset *state, const AfGyroOffsetCoef *coef, const
     }
     int still = dg2 < coef->rest_gyr * coef->rest_gyr && da2 < coef->rest_acc * coef->rest_acc &&
                 g2 < coef->rest_gyr_abs * coef->rest_gyr_abs;
+    if (still) /* the gyro through tau_rest from the start of the rest (where it has long forgotten that start) */
+        for (int i = 0; i < 3; i++)
+            state->rest_gyr_mean[i] += (state->rest == 0.0 ? 1.0 : coef->a_rest) * (gyr[i] - state->rest_gyr_mean[i]);
     state->rest = still ? state->rest + Ts : 0.0;
     double old[3] = {state->acc_lp[0][0], state->acc_lp[0][1], state->acc_lp[0][2]};
     if (V > 0.0) { /* tracking while moving: the gyro frame and its low-passes */
@@ -253,6 +335,26 @@ static inline void step(AfGyroOffset *state, const AfGyroOffsetCoef *coef, const
         lowpass(&state->rb_lp[0][0], &state->rb_lp[1][0], rb.x, coef->Ad, coef->Bd);
         lowpass(&state->rb_lp[0][1], &state->rb_lp[1][1], rb.y, coef->Ad, coef->Bd);
         lowpass(&state->rb_lp[0][2], &state->rb_lp[1][2], rb.z, coef->Ad, coef->Bd);
+        if (coef->arm_every > 0.0) { /* the lever arm: w and alpha from this sample and the one before */
+            double *before = state->arm_gyr, phase = state->arm_phase += 1.0;
+            int fit = phase >= coef->arm_every;
+            int on = state->arm[0] != 0.0 || state->arm[1] != 0.0 || state->arm[2] != 0.0;
+            if (fit || on) {
+                double rate = 1.0 / Ts;
+                double w[3] = {0.5 * (gyr[0] + before[0]) - b[0], 0.5 * (gyr[1] + before[1]) - b[1],
+                               0.5 * (gyr[2] + before[2]) - b[2]};
+                double alpha[3] = {(gyr[0] - before[0]) * rate, (gyr[1] - before[1]) * rate,
+                                   (gyr[2] - before[2]) * rate};
+                arm_accelerations(w, alpha, state->arm, removed);
+                if (fit) {
+                    double y[3] = {a.x, a.y, a.z};
+                    state->arm_phase = 0.0;
+                    arm_fit(state, coef, R, y, w, alpha);
+                }
+            }
+            if (on || phase + 1.0 >= coef->arm_every) /* the sample before the next that needs one */
+                before[0] = gyr[0], before[1] = gyr[1], before[2] = gyr[2];
+        }
     }
     for (int i = 0; i < 3; i++) {
         double p = P[4 * i] + V;
@@ -264,7 +366,7 @@ static inline void step(AfGyroOffset *state, const AfGyroOffsetCoef *coef, const
     if (rested && allowed) { /* each axis of the gyro sample measures b with variance r */
         for (int i = 0; i < 3; i++) {
             double h[3] = {i == 0 ? 1.0 : 0.0, i == 1 ? 1.0 : 0.0, i == 2 ? 1.0 : 0.0};
-            scalar_update(b, P, h, gyr[i], coef->r);
+            scalar_update(b, P, h, state->rest_gyr_mean[i], coef->r);
         }
     } else if (V > 0.0 && state->t > coef->settle) {
         motion_update(b, P, old, state->acc_lp[0], state->r_lp[0], state->rb_lp[0], Ts, coef->W, coef->clip);
@@ -273,19 +375,22 @@ static inline void step(AfGyroOffset *state, const AfGyroOffsetCoef *coef, const
         offset[i] = b[i];
         variance[i] = P[4 * i];
     }
+    if (acc_out != NULL && (acc_out != acc || removed[0] != 0.0 || removed[1] != 0.0 || removed[2] != 0.0))
+        for (int i = 0; i < 3; i++) /* acc read above: acc_out may be acc */
+            acc_out[i] = acc[i] - removed[i];
 }
 
 void gyro_offset_step(AfGyroOffset *state, const AfGyroOffsetCoef *coef, const double gyr[3], const double acc[3],
-                      double offset[3], double variance[3])
+                      double offset[3], double variance[3], double acc_out[3])
 {
-    step(state, coef, gyr, acc, 1, offset, variance, NULL);
+    step(state, coef, gyr, acc, 1, offset, variance, acc_out, NULL);
 }
 
 void gyro_offset_run(AfGyroOffset *state, const AfGyroOffsetCoef *coef, size_t n, const double *gyr,
                      const double *acc, const unsigned char *allowed, double *offset, double *variance,
-                     unsigned char *resting)
+                     double *acc_out, unsigned char *resting)
 {
     for (size_t k = 0; k < n; k++)
         step(state, coef, gyr + 3 * k, acc + 3 * k, allowed == NULL || allowed[k], offset + 3 * k, variance + 3 * k,
-             resting != NULL ? resting + k : NULL);
+             acc_out != NULL ? acc_out + 3 * k : NULL, resting != NULL ? resting + k : NULL);
 }

@@ -10,9 +10,9 @@ from attitude_fmu.systems.fmi.interface.escaping import c_double, c_string
 from attitude_fmu.systems.fmi.interface.variables import IN, OUT, PAR, REAL, Table, element_names
 
 # a signal's unit by its label's stem, as the project's blocks name their signals (FMI unit names)
-UNIT_STEMS = {"gyr": "rad/s", "gyr_raw": "rad/s", "omega": "rad/s", "offset": "rad/s", "acc": "m/s2", "f": "m/s2",
-              "ghat": "m/s2", "ghatl": "m/s2", "mag": "uT", "m": "uT", "mag_offset": "uT", "incl_err": "rad",
-              "q": "1", "qt": "1", "qh": "1", "ql": "1"}
+UNIT_STEMS = {"gyr": "rad/s", "gyr_raw": "rad/s", "omega": "rad/s", "offset": "rad/s", "acc": "m/s2", "acc_raw": "m/s2",
+              "f": "m/s2", "ghat": "m/s2", "ghatl": "m/s2", "mag": "uT", "m": "uT", "mag_offset": "uT",
+              "incl_err": "rad", "q": "1", "qt": "1", "qh": "1", "ql": "1"}
 KINDS = ("lti", "method", "filter", "gyro_offset", "heading", "latency", "imu", "magnetometer", "human",
          "closed_form", "error")  # DiagramKind's order (fmu_src/diagram/diagram.h)
 MATRICES = ("A", "B", "C", "D")
