@@ -43,8 +43,10 @@ into the gyro frame (ω the corrected gyro's mean over the sample, α its differ
 high-passed over 10 s (gravity, and the slow turn an offset error gives the frame), feed
 least-squares sums that forget over tau_arm; their solution r (m, sensor coordinates) is
 removed from the accelerometer handed to the method from the next sample on, where it explains
-at least 90 % of what the high-pass leaves, at least 0.05 m/s² RMS of it, and is under 3 m
-(else nothing is removed: at rest, in hand-held motion, on a centre that moves itself).
+at least 90 % of what the high-pass leaves, at least 0.05 m/s² RMS of it, is under 3 m, and
+what is left is carried by four fit samples or more ((Σ|y|²)²/Σ|y|⁴: a motion's abrupt onset
+after a quiet rest, one sample, fits some arm); else nothing is removed (at rest, in hand-held
+motion, on a centre that moves itself).
 Offline the arm is fitted over the whole recording instead (blocks.stages.lever_arm).
 The corrected gyro is the measured one minus the estimate after its sample. Causal: one step
 per sample, in the C core (blocks/core/stages/gyro_offset.c); its parameters are
