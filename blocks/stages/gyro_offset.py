@@ -152,7 +152,7 @@ def offset_estimate(gyr, acc, fs: float, params=None, offline: bool = False):
         return offset, variance, resting
 
     if not offline:
-        return online_pass(gyr, acc, fs, params)[:2]
+        return one_pass(gyr, acc)[:2]
     # a rest's sample measures the offset where the rest holds rest_time before and after it: a motion's onset,
     # which the detection still takes for rest, is then no rest backward in time
     backward = time_reversed(gyr), np.ascontiguousarray(acc[::-1])
