@@ -131,32 +131,59 @@ static void across(const double v[3], double e[3])
     }
 }
 
+/* joint_update: Kalman update of the offset b (P its covariance, both in place) from two independent scalar
+ * measurements: innovation nu[a] of g[a].b, variance w[a] (the 2 x 2 innovation covariance inverted in closed
+ * form: one division) */
+static inline void joint_update(double b[3], double P[9], const double g1[3], const double g2[3], const double nu[2],
+                                const double w[2])
+{
+    double Pg1[3], Pg2[3];
+    mat_vec(P, g1, Pg1);
+    mat_vec(P, g2, Pg2);
+    double s11 = dot(g1, Pg1) + w[0], s12 = dot(g1, Pg2), s22 = dot(g2, Pg2) + w[1];
+    double inv_det = 1.0 / (s11 * s22 - s12 * s12);
+    double i11 = s22 * inv_det, i12 = -s12 * inv_det, i22 = s11 * inv_det; /* S^-1 */
+    double x1 = i11 * nu[0] + i12 * nu[1], x2 = i12 * nu[0] + i22 * nu[1];
+    double K1[3], K2[3]; /* the gain P.G^T.S^-1, by columns */
+    for (int i = 0; i < 3; i++) {
+        b[i] += Pg1[i] * x1 + Pg2[i] * x2;
+        K1[i] = Pg1[i] * i11 + Pg2[i] * i12;
+        K2[i] = Pg1[i] * i12 + Pg2[i] * i22;
+    }
+    for (int i = 0; i < 3; i++)
+        for (int j = i; j < 3; j++) { /* P -= K.G.P, symmetric: each entry once */
+            double dP = K1[i] * Pg1[j] + K2[i] * Pg2[j];
+            P[3 * i + j] -= dP;
+            if (j != i)
+                P[3 * j + i] -= dP;
+        }
+}
+
 /* motion_update: Kalman update of the offset b (P its covariance) from the turn of the low-passed
  * accelerometer from old to new (gyro frame); r_lp, rb_lp: LP(R) (row-major) and LP(R.b).
  * The turn rate plus Pi.LP(R.b^) measures H.b, H = Pi.LP(R) (the low-pass delays the turn after a
  * change of b^); the innovation is clipped per component. H has rank 2 at most (Pi projects across
- * gravity): its singular directions are those of the 2 x 2 problem in a basis (e1, e2) across
- * gravity, in closed form. Only directions H keeps at least OBSERVED of are used, each as a scalar
- * measurement u.e of (H^T u).b with variance W (u orthonormal: the joint update, taken one
- * direction at a time). The basis and the directions are left unnormalised (e1, e2 of one length
- * k, the 2 x 2 eigenvector of length L): a scalar measurement scaled by k.L, its variance by
- * (k.L)^2, updates alike; that keeps square roots and divisions off the path from one sample's
- * estimate to the next. */
+ * gravity): measured in a basis (e0, e2) across gravity, each component u.e of the innovation measures
+ * (H^T u).b with variance W |u|^2, the two independent. Only directions H keeps at least OBSERVED of
+ * are used: the singular values of the 2 x 2 problem M.M^T (M = (e1, e2)^T.LP(R), e1 = |new| e0 of e2's
+ * length k) in closed form. Where both are kept (most samples) the joint update takes both components
+ * (the same update as one scalar update after the other along the singular directions); else the larger's
+ * direction alone, where kept, is a scalar update. The basis and the directions are left unnormalised (a
+ * scalar measurement scaled by a length, its variance by its square, updates alike) and the test is made
+ * in squares: that keeps square roots and all but one division of the update off the path from one
+ * sample's estimate to the next. */
 static void motion_update(double b[3], double P[9], const double old[3], const double new[3], const double r_lp[9],
                           const double rb_lp[3], double Ts, double W, double clip)
 {
     double n2 = dot(new, new);
     if (n2 == 0.0)
         return;
-    double e0[3], e1[3], e2[3];
+    double e0[3], e2[3];
     across(new, e0);
-    double norm = sqrt(n2);
-    e1[0] = norm * e0[0], e1[1] = norm * e0[1], e1[2] = norm * e0[2];
     e2[0] = new[1] * e0[2] - new[2] * e0[1];
     e2[1] = new[2] * e0[0] - new[0] * e0[2];
     e2[2] = new[0] * e0[1] - new[1] * e0[0];
-    double k2 = n2 * dot(e0, e0); /* |e1|^2 = |e2|^2 */
-    double b0[3] = {b[0], b[1], b[2]};
+    double q0 = dot(e0, e0), k2 = n2 * q0; /* |e0|^2, |e2|^2 */
     double s = 1.0 / (n2 * Ts);
     double turn[3] = {(old[1] * new[2] - old[2] * new[1]) * s, (old[2] * new[0] - old[0] * new[2]) * s,
                       (old[0] * new[1] - old[1] * new[0]) * s};
@@ -168,14 +195,24 @@ static void motion_update(double b[3], double P[9], const double old[3], const d
      * double at a time and read back in pairs (a store-forwarding stall on the path to the next sample) */
     double e[3] = {clipped(turn[0] + d[0] - along * new[0], clip), clipped(turn[1] + d[1] - along * new[1], clip),
                    clipped(turn[2] + d[2] - along * new[2], clip)};
-    /* M = (e1, e2)^T.LP(R), 2 x 3; the eigenvectors of M.M^T are H's left singular directions */
-    double m1[3], m2[3];
-    mat_t_vec(r_lp, e1, m1);
-    mat_t_vec(r_lp, e2, m2);
-    double p11 = dot(m1, m1), p12 = dot(m1, m2), p22 = dot(m2, m2);
-    double half = 0.5 * (p11 - p22), mean = 0.5 * (p11 + p22);
-    double radius = sqrt(half * half + p12 * p12);
-    /* the eigenvector of the larger eigenvalue mean + radius, in its well-conditioned form */
+    double g1[3], g2[3]; /* H^T.e0, H^T.e2 */
+    mat_t_vec(r_lp, e0, g1);
+    mat_t_vec(r_lp, e2, g2);
+    /* M.M^T = ((n2 g1.g1, |new| g1.g2), (|new| g1.g2, g2.g2)): both eigenvalues mean +- radius at least
+     * OBSERVED^2 k2 where mean - OBSERVED^2 k2 >= radius >= 0 */
+    double g12 = dot(g1, g2), p11 = n2 * dot(g1, g1), p22 = dot(g2, g2);
+    double half = 0.5 * (p11 - p22), mean = 0.5 * (p11 + p22), least = OBSERVED * OBSERVED * k2;
+    double spare = mean - least, p12_2 = n2 * g12 * g12;
+    if (spare >= 0.0 && spare * spare >= half * half + p12_2) {
+        double nu[2] = {dot(e0, e), dot(e2, e)}, w[2] = {W * q0, W * k2};
+        joint_update(b, P, g1, g2, nu, w);
+        return;
+    }
+    /* else the larger eigenvalue mean + radius's direction alone, where it is kept: its eigenvector in the
+     * well-conditioned form (c, sn) in the basis (e1, e2), of length L */
+    double norm = sqrt(n2), p12 = norm * g12, radius = sqrt(half * half + p12_2);
+    if (mean + radius < least)
+        return;
     double c, sn;
     if (half >= 0.0)
         c = half + radius, sn = p12;
@@ -184,19 +221,10 @@ static void motion_update(double b[3], double P[9], const double old[3], const d
     double L2 = c * c + sn * sn;
     if (L2 == 0.0)
         c = 1.0, sn = 0.0, L2 = 1.0;
-    for (int a = 0; a < 2; a++) {
-        if (a == 1) {
-            double c0 = c;
-            c = -sn, sn = c0;
-        }
-        if (mean + (a == 0 ? radius : -radius) < OBSERVED * OBSERVED * k2)
-            continue;
-        double u[3] = {c * e1[0] + sn * e2[0], c * e1[1] + sn * e2[1], c * e1[2] + sn * e2[2]};
-        double h[3] = {c * m1[0] + sn * m2[0], c * m1[1] + sn * m2[1], c * m1[2] + sn * m2[2]}; /* H^T.u */
-        /* u.e measures h.b at the b the innovation was taken at; later directions see the update */
-        double z = dot(u, e) + dot(h, b0);
-        scalar_update(b, P, h, z, W * L2 * k2);
-    }
+    double cn = c * norm; /* u = c e1 + sn e2 = cn e0 + sn e2 */
+    double u[3] = {cn * e0[0] + sn * e2[0], cn * e0[1] + sn * e2[1], cn * e0[2] + sn * e2[2]};
+    double h[3] = {cn * g1[0] + sn * g2[0], cn * g1[1] + sn * g2[1], cn * g1[2] + sn * g2[2]}; /* H^T.u */
+    scalar_update(b, P, h, dot(u, e) + dot(h, b), W * L2 * k2); /* the innovation u.e */
 }
 
 /* arm_accelerations: A.r = alpha x r + w x (w x r) */
