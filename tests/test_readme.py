@@ -124,7 +124,8 @@ def test_the_readmes_results_are_those_the_figure_script_wrote():
             f"{online['vqf_9d'][head]:.2f}°") in section
     bench = json.loads((GENERATED / "bench.json").read_text())
     assert f"about {bench['ratio_vs_vqf']['wiener_held']:.0f}× the samples per second" in section
-    assert f"({bench['ratio_vs_vqf']['wiener']:.1f}× where the\n  batch path chooses" in section
+    assert (f"tracks the gyro offset, {bench['ratio_vs_vqf']['wiener_offset']:.1f}× (9D: "
+            f"{bench['ratio_vs_vqf_9d']['wiener_9d']:.1f}× vqf 9D's)") in section
     io = json.loads((GENERATED / "bench_io.json").read_text())["ratio_vs_peers"]
     assert (f"in {io['csv_to_csv']:.2f}× the time of pandas + vqf + pandas (Parquet: "
             f"{io['parquet_to_parquet']:.2f}×)") in section
