@@ -117,15 +117,25 @@ def correct(gyr, acc, fs: float, params=None, offline: bool = False):
     return np.asarray(gyr, dtype=float) - offset, offset
 
 
+def _pass(coef, gyr, acc, allowed=None, resting: bool = False, freed: bool = False):
+    """One causal pass over contiguous gyr, acc (N×3) from the start at rest on their first row:
+    (offset N×3, variance N×3, resting flags N or None, acc freed of the online lever arm N×3 or None),
+    the optional outputs only where wanted; allowed as _core.gyro_offset_run takes it."""
+    offset, variance = np.empty_like(gyr), np.empty_like(gyr)
+    flags = np.empty(len(gyr), dtype=np.bool_) if resting else None
+    out = np.empty_like(acc) if freed else None
+    _core.gyro_offset_run(initial_state(coef, gyr[0], acc[0]), coef, gyr, acc, offset, variance, allowed, flags,
+                          acc_out=out)
+    return offset, variance, flags, out
+
+
 def online_pass(gyr, acc, fs: float, params=None):
     """The estimator's causal pass over a whole recording (gyr N×3 rad/s, acc N×3 m/s², fs Hz):
     (offset estimate N×3 rad/s, its variance per axis N×3 (rad/s)², acc freed of the online
     lever arm's accelerations N×3 m/s², as the causal pipeline hands it to the method)."""
     gyr = np.ascontiguousarray(gyr, dtype=float)
     acc = np.ascontiguousarray(acc, dtype=float)
-    coef = coefficients(resolve(params), 1.0 / fs)
-    offset, variance, freed = np.empty_like(gyr), np.empty_like(gyr), np.empty_like(acc)
-    _core.gyro_offset_run(initial_state(coef, gyr[0], acc[0]), coef, gyr, acc, offset, variance, acc_out=freed)
+    offset, variance, _, freed = _pass(coefficients(resolve(params), 1.0 / fs), gyr, acc, freed=True)
     return offset, variance, freed
 
 
@@ -147,12 +157,10 @@ def offset_estimate(gyr, acc, fs: float, params=None, offline: bool = False):
     coef = coefficients(resolved, 1.0 / fs)
 
     def one_pass(g, a, allowed=None):
-        offset, variance, resting = np.empty_like(g), np.empty_like(g), np.empty(len(g), dtype=np.bool_)
-        _core.gyro_offset_run(initial_state(coef, g[0], a[0]), coef, g, a, offset, variance, allowed, resting)
-        return offset, variance, resting
+        return _pass(coef, g, a, allowed, resting=True)[:3]
 
     if not offline:
-        return one_pass(gyr, acc)[:2]
+        return _pass(coef, gyr, acc)[:2]
     # a rest's sample measures the offset where the rest holds rest_time before and after it: a motion's onset,
     # which the detection still takes for rest, is then no rest backward in time
     backward = time_reversed(gyr), np.ascontiguousarray(acc[::-1])

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "methods/wiener_local.h"
+#include "stages/lever_arm.h"
 #include "quaternion.h"
 
 #define OBSERVED 0.5    /* the least share of an offset's effect H must keep in a direction to update it */
@@ -246,15 +247,8 @@ static void arm_fit(AfGyroOffset *state, const AfGyroOffsetCoef *coef, const dou
                     const double w[3], const double alpha[3])
 {
     double A[9], X[9], dy[3], dX[9];
-    double w2 = dot(w, w);
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
-            A[3 * i + j] = w[i] * w[j] - (i == j ? w2 : 0.0);
-    A[1] -= alpha[2], A[2] += alpha[1], A[5] -= alpha[0];
-    A[3] += alpha[2], A[6] -= alpha[1], A[7] += alpha[0];
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
-            X[3 * i + j] = R[3 * i] * A[j] + R[3 * i + 1] * A[3 + j] + R[3 * i + 2] * A[6 + j];
+    lever_arm_terms(w, alpha, A);
+    lever_arm_turned(R, A, X);
     if (state->arm_time == 0.0) { /* the high-pass starts on its first sample */
         memcpy(state->arm_y, y, sizeof state->arm_y);
         memcpy(state->arm_x, X, sizeof state->arm_x);
@@ -373,7 +367,8 @@ static inline void step(AfGyroOffset *state, const AfGyroOffsetCoef *coef, const
                                0.5 * (gyr[2] + before[2]) - b[2]};
                 double alpha[3] = {(gyr[0] - before[0]) * rate, (gyr[1] - before[1]) * rate,
                                    (gyr[2] - before[2]) * rate};
-                arm_accelerations(w, alpha, state->arm, removed);
+                if (on)
+                    arm_accelerations(w, alpha, state->arm, removed);
                 if (fit) {
                     double y[3] = {a.x, a.y, a.z};
                     state->arm_phase = 0.0;

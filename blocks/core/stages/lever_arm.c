@@ -50,12 +50,7 @@ static void rotation_terms(size_t n, size_t k, const double *gyr, double Ts, siz
         rate[i] = 0.5 * (before[i] + after[i]) / (double)span;
         turn[i] = (after[i] - before[i]) / ((double)span * (double)span * Ts);
     }
-    double rate2 = rate[0] * rate[0] + rate[1] * rate[1] + rate[2] * rate[2];
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
-            A[3 * i + j] = rate[i] * rate[j] - (i == j ? rate2 : 0.0);
-    A[1] -= turn[2], A[2] += turn[1], A[5] -= turn[0];
-    A[3] += turn[2], A[6] -= turn[1], A[7] += turn[0];
+    lever_arm_terms(rate, turn, A);
 }
 
 void lever_arm_removed(size_t n, const double *gyr, const double *acc, double Ts, size_t span, const double r[3],
@@ -84,11 +79,9 @@ void lever_arm_sums(size_t n, const double *gyr, const double *acc, double Ts, s
         double R[9], A[9], X[9], y[3];
         quat_matrix(q, R);
         rotation_terms(n, k, gyr, Ts, span, A);
-        for (int i = 0; i < 3; i++) {
+        lever_arm_turned(R, A, X);
+        for (int i = 0; i < 3; i++)
             y[i] = R[3 * i] * a[0] + R[3 * i + 1] * a[1] + R[3 * i + 2] * a[2];
-            for (int j = 0; j < 3; j++)
-                X[3 * i + j] = R[3 * i] * A[j] + R[3 * i + 1] * A[3 + j] + R[3 * i + 2] * A[6 + j];
-        }
         for (int i = 0; i < 3; i++) {
             for (int j = 0; j < 3; j++)
                 w.xx[3 * i + j] += X[i] * X[j] + X[3 + i] * X[3 + j] + X[6 + i] * X[6 + j];
